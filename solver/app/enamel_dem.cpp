@@ -1,0 +1,178 @@
+// enamel-dem: the command-line front end. A thin layer: parse the command line and the case, then call
+// the library (geometry, simulation, runner). Every failure class has its own exit status (exit_codes.hpp).
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "beam.hpp"
+#include "case_params.hpp"
+#include "exit_codes.hpp"
+#include "geometry.hpp"
+#include "integrators.hpp"
+#include "runner.hpp"
+#include "simulation.hpp"
+
+namespace fs = std::filesystem;
+using namespace enamel;
+
+namespace {
+
+int fail(int code, const std::string& message) {
+  std::fprintf(stderr, "enamel-dem: error: %s\n", message.c_str());
+  return code;
+}
+
+struct CaseArgs {
+  std::string casePath;
+  std::string preset;
+  std::vector<std::string> sets;
+  void addTo(CLI::App* cmd) {
+    cmd->add_option("case", casePath, "case file (TOML); 'enamel-dem keys' lists every key")->required();
+    cmd->add_option("--preset,-p", preset,
+                    "size preset: ci | reduced | paper (specimen size, mesh, loading rate, stop criterion); "
+                    "precedence: key defaults < preset < case file < --set");
+    cmd->add_option("--set,-s", sets, "override one key, as key=value (TOML value), repeatable");
+  }
+};
+
+int runInfo(const CaseArgs& args) {
+  const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
+  Simulation sim(p);
+  const Model& m = sim.model;
+  int byTag[4] = {0, 0, 0, 0};
+  for (auto t : m.ifaceTag) ++byTag[t];
+  const double wAxial = beam::closedFormAxialOmegaMax(sim.section, m.beamLength);
+  const double wBend = beam::closedFormBendingOmegaMax(sim.section, m.beamLength, sim.section.Iy);
+  std::printf("case               %s%s%s\n", p.sourceName.c_str(), p.presetName.empty() ? "" : "  preset ",
+              p.presetName.c_str());
+  std::printf("theta_D            %g deg   Er/kd %g   sigma_ru/sigma0 %g   cv %g\n", p.theta_D, p.Er_over_kd,
+              p.sigma_ru_over_sigma0, p.cv);
+  std::printf("specimen           w_s %g d x h_s %g d, z-period B %.4f d, pre-crack a0 %g d\n", m.w_s, m.h_s, m.B, m.a0);
+  std::printf("slices             %d (h_e %.4f d)\n", m.numSlices, m.h_e);
+  std::printf("rods               %d\n", m.numRods());
+  std::printf("nodes              %d\n", m.numNodes());
+  std::printf("DOF                %d (6 per node), %zu prescribed\n", m.numDofs(), sim.prescribedDofs.size());
+  std::printf("beam elements      %d (+%d cut by the pre-crack), length %.4f d\n", m.numBeams(), m.precrackBeams,
+              m.beamLength);
+  std::printf("interfaces         %d (+%d cut by the pre-crack)\n", m.numInterfaces(), m.precrackInterfaces);
+  for (int t = 0; t < 4; ++t) std::printf("  %-30s %d\n", interfaceTagName(t), byTag[t]);
+  std::printf("element frequency  omega_max %.4g c_r/d: %s governs (bending %.4g, axial %.4g)\n",
+              sim.omegaMaxElement, wBend > wAxial ? "bending" : "axial", wBend, wAxial);
+  std::printf("time step          dt %.4g d/c_r (integrator %s)\n", sim.integrator->timeStep(),
+              sim.integrator->name().c_str());
+  std::printf("transverse modulus E_transverse %.4g E_r, c_d %.4g c_r%s\n", sim.E_transverse, sim.c_d,
+              p.E_transverse_over_Er > 0 ? " (given)" : " (measured)");
+  std::printf("damping            zeta %g at w_min %.4g: a %.4g, b %.4g\n", p.zeta, sim.omegaMin, sim.dampA, sim.dampB);
+  std::printf("loading            v_app %.4g d c_r/d, ramp %.4g d/c_r\n", sim.loading.vApp, sim.loading.rampTime);
+  return exit_code::ok;
+}
+
+// Output directory: created if needed, must be writable, and must not hold a result unless --force.
+int prepareOutput(const std::string& dir, bool force, std::string& resultPath) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return fail(exit_code::output_unwritable, "cannot create output directory '" + dir + "': " + ec.message());
+  resultPath = (fs::path(dir) / "result.h5").string();
+  if (fs::exists(resultPath) && !force)
+    return fail(exit_code::output_exists,
+                "'" + resultPath + "' exists; use --force to overwrite it (nothing was changed)");
+  const std::string probe = (fs::path(dir) / ".write-test").string();
+  {
+    std::ofstream f(probe);
+    if (!f) return fail(exit_code::output_unwritable, "output directory '" + dir + "' is not writable");
+  }
+  fs::remove(probe, ec);
+  return exit_code::ok;
+}
+
+int runRun(const CaseArgs& args, std::string outDir, bool force, bool quiet) {
+  const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
+  if (outDir.empty())
+    outDir = (fs::path("runs") / (p.presetName.empty() ? "default" : p.presetName) / fs::path(p.sourceName).stem())
+                 .string();
+  std::string resultPath;
+  if (int rc = prepareOutput(outDir, force, resultPath)) return rc;
+  Simulation sim(p);
+  std::signal(SIGINT, requestStop);
+  std::signal(SIGTERM, requestStop);
+  if (!quiet)
+    std::fprintf(stderr, "enamel-dem: %s: %d DOF, %d interfaces, dt %.3g, integrator %s -> %s\n",
+                 p.sourceName.c_str(), sim.model.numDofs(), sim.model.numInterfaces(), sim.integrator->timeStep(),
+                 sim.integrator->name().c_str(), resultPath.c_str());
+  RunOptions opt;
+  opt.resultPath = resultPath;
+  opt.progress = !quiet;
+  const RunRecord rec = runSimulation(sim, opt);
+  const RcurveSummary s = [&] {
+    std::vector<double> R;
+    for (double J : rec.rcurveJ) R.push_back(J / p.Gamma());
+    return summariseRcurve(rec.rcurveDa, R);
+  }();
+  std::fprintf(stderr, "enamel-dem: %s: %s after %ld steps, %.1f s: %s\n", p.sourceName.c_str(), rec.status.c_str(),
+               rec.steps, rec.wallSeconds, rec.stopReason.c_str());
+  std::fprintf(stderr, "enamel-dem: R_init/Gamma %.4g  R_ss/Gamma %.4g  da_max/d %.3g  broken rods %d  energy balance %.3g\n",
+               s.R_init, s.R_ss, s.daMax, sim.state.brokenBeams,
+               rec.history.empty() ? 0.0 : rec.history.back().balanceError);
+  for (const auto& w : rec.warnings) std::fprintf(stderr, "enamel-dem: warning: %s\n", w.c_str());
+  if (rec.status == "failed") return fail(exit_code::run_unstable, rec.stopReason + " (partial result kept in " + resultPath + ")");
+  if (rec.status == "interrupted") return exit_code::interrupted;
+  return exit_code::ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"enamel-dem: discrete element fracture of decussating crossply microstructures (tooth enamel),\n"
+               "after Pro & Barthelat 2020, J. Mech. Phys. Solids. Normalised units: d = E_r = rho_r = 1."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(ENAMEL_VERSION) + " (" + ENAMEL_GIT_HASH + ")");
+
+  CaseArgs infoArgs, runArgs;
+  CLI::App* info = app.add_subcommand("info", "print the model built from a case: counts of rods, nodes, beam "
+                                              "elements, interfaces by tag, DOF, governing element frequency, dt");
+  infoArgs.addTo(info);
+
+  CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5");
+  runArgs.addTo(run);
+  std::string outDir;
+  bool force = false, quiet = false;
+  run->add_option("--out,-o", outDir, "output directory (default runs/<preset>/<case name>)");
+  run->add_flag("--force", force, "overwrite an existing result.h5");
+  run->add_flag("--quiet,-q", quiet, "no progress lines");
+
+  CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return exit_code::usage;
+  }
+
+  try {
+    if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
+    if (*info) return runInfo(infoArgs);
+    if (*run) return runRun(runArgs, outDir, force, quiet);
+  } catch (const CaseError& e) {
+    return fail(e.exitCode, e.what());
+  } catch (const IntegratorError& e) {
+    return fail(exit_code::out_of_range, e.what());
+  } catch (const std::invalid_argument& e) {
+    return fail(exit_code::out_of_range, e.what());
+  } catch (const std::exception& e) {
+    return fail(exit_code::run_failed, e.what());
+  }
+  return exit_code::usage;
+}

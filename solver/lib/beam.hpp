@@ -1,0 +1,86 @@
+#pragma once
+// 3D Euler-Bernoulli beam element for the enamel rods (DESIGN.md sections 2-4), as pure functions:
+// section properties, local frame, local/global stiffness and mass, end forces, the brittle stress
+// check and the element eigenfrequencies that set the stable time step.
+// GCC 12 emits a known false-positive -Wmaybe-uninitialized from Eigen's self-adjoint eigensolver
+// (SelfadjointMatrixVector.h, used by eigenfrequencies); it must be silenced where Eigen is parsed.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <Eigen/Dense>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace enamel::beam {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Vec12 = Eigen::Matrix<double, 12, 1>;
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+
+// DOF order everywhere: node a (ux uy uz rx ry rz), then node b (same). Local axis x' from a to b.
+struct Section {
+  double E, G, rho;  // Young's modulus, shear modulus, density
+  double A;          // area
+  double Iy, Iz;     // second moments of area about local y', z'
+  double Ip;         // polar moment Iy+Iz (torsional rotary inertia)
+  double J;          // torsion constant (stiffness GJ/L)
+  double c;          // extreme-fibre distance for the stress check
+};
+
+// Space-filling regular hexagon of across-flats width d:
+//   A = sqrt(3)/2 d^2, Iy = Iz = 5 sqrt(3)/144 d^4, Ip = Iy + Iz, J = 0.11505 d^4, c = d/2, G = E/(2(1+nu)).
+// J is computed (see beam.cpp), not taken from a table.
+Section hexagonalSection(double d, double E, double nu, double rho);
+// Circle of diameter d: A = pi d^2/4, Iy = Iz = pi d^4/64, Ip = J = pi d^4/32, c = d/2.
+Section circularSection(double d, double E, double nu, double rho);
+
+// Rows of the returned matrix are the local unit axes e1 (a->b), e2, e3, so v_local = R * v_global.
+// e3 = normalize(zhat - (zhat.e1) e1) (= e1 x (zhat x e1)), e2 = e3 x e1: a beam in the xy-plane has
+// e3 = +z. A beam parallel to z gets e2 = +x, e3 = e1 x e2.
+Mat3 localFrame(const Vec3& xa, const Vec3& xb);
+
+// Standard 3D Euler-Bernoulli stiffness in the local frame (axial EA/L, torsion GJ/L, bending in x'y'
+// with Iz and in x'z' with Iy; no shear deformation).
+Mat12 localStiffness(const Section& s, double L);
+// Consistent translational mass (linear shape functions for axial, cubic Hermite for bending) plus
+// torsional rotary inertia rho Ip L/6 [2 1; 1 2]; no bending rotary inertia. Positive definite.
+Mat12 localConsistentMass(const Section& s, double L);
+// Diagonal lumped mass: translations rho A L/2 per node; rotations rotaryScale * rho L/2 * (Ip, Iy, Iz).
+Vec12 lumpedMassDiagonal(const Section& s, double L, double rotaryScale = 1.0);
+
+// T^T M T with T = blockdiag(R, R, R, R) (R from localFrame): local -> global for K or M.
+Mat12 rotateToGlobal(const Mat12& Mlocal, const Mat3& R);
+Mat12 globalStiffness(const Section& s, const Vec3& xa, const Vec3& xb);
+Mat12 globalConsistentMass(const Section& s, const Vec3& xa, const Vec3& xb);
+
+// f_local = K_local * T * u_global: the nodal forces/moments (local axes) that must be APPLIED to the
+// element's nodes to hold the displacement u_global. The element exerts -f_local on its nodes, so the
+// internal-force contribution to the global residual is +T^T f_local (M a + K u = f_ext).
+Vec12 localEndForces(const Section& s, double L, const Mat3& R, const Vec12& uGlobal);
+
+// Brittle check (DESIGN section 3): max over both ends of
+//   sigma = N/A + sqrt((My c/Iy)^2 + (Mz c/Iz)^2),  N = f_local[6] = -f_local[0] (tension positive),
+// end moments (My, Mz) = f_local[4,5] at node a and f_local[10,11] at node b.
+double maxTensileStress(const Section& s, const Vec12& fLocal);
+
+// Free-free element eigenfrequencies omega (rad per unit time) of K phi = omega^2 M phi, ascending;
+// the six rigid-body zeros come out as round-off and are clamped at 0. M must be positive definite
+// (throws std::invalid_argument otherwise, e.g. lumped mass with rotaryScale = 0).
+Eigen::VectorXd eigenfrequencies(const Mat12& K, const Mat12& M);
+
+enum class MassKind { Consistent, Lumped };
+// Largest element frequency (governs the stable time step), rotaryScale used for Lumped only.
+double maxFrequency(const Section& s, double L, MassKind kind, double rotaryScale = 1.0);
+
+// Closed forms for the consistent-mass element (verified against eigenfrequencies in test_beam.cpp):
+//   axial   omega_max = sqrt(12 E/rho) / L                    (linear bar, free-free)
+//   bending omega_max = sqrt(8400 E I / (rho A L^4))          (cubic Hermite, free-free; the other
+//                                                              flexible bending mode is 720)
+// Hexagon, d = E = rho = 1, L = 0.3: bending ~268.4, axial ~11.55.
+double closedFormAxialOmegaMax(const Section& s, double L);
+double closedFormBendingOmegaMax(const Section& s, double L, double I);
+
+}  // namespace enamel::beam

@@ -1,0 +1,132 @@
+#include "cohesive.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace enamel::cohesive {
+
+double Law::delta0() const { return sigma0 / k; }
+double Law::delta1() const { return Gamma / sigma0; }
+double Law::deltaf() const { return delta1() + delta0(); }
+
+Law makeLaw(double k, double sigma0, double Gamma) {
+  // !(x > 0) also rejects NaN.
+  if (!(k > 0.0)) throw std::invalid_argument("cohesive law: stiffness k must be > 0, got " + std::to_string(k));
+  if (!(sigma0 > 0.0))
+    throw std::invalid_argument("cohesive law: strength sigma0 must be > 0, got " + std::to_string(sigma0));
+  if (!(Gamma > 0.0))
+    throw std::invalid_argument("cohesive law: fracture energy Gamma must be > 0, got " + std::to_string(Gamma));
+  // Trapezoid needs delta1 >= delta0, i.e. Gamma >= sigma0^2/k (equality: triangle).
+  if (Gamma < sigma0 * sigma0 / k)
+    throw std::invalid_argument("cohesive law: fracture energy Gamma = " + std::to_string(Gamma) +
+                                " must be >= sigma0^2/k = " + std::to_string(sigma0 * sigma0 / k) +
+                                " (plateau end delta1 = Gamma/sigma0 below elastic limit delta0 = sigma0/k)");
+  return Law{k, sigma0, Gamma};
+}
+
+// T(lambda) = k lambda                          for lambda <= delta0
+//           = sigma0                            for delta0 < lambda <= delta1
+//           = sigma0 (deltaf - lambda)/delta0   for delta1 < lambda < deltaf   (deltaf - delta1 = delta0)
+//           = 0                                 for lambda >= deltaf
+double envelopeTraction(const Law& law, double lambda) {
+  const double d0 = law.delta0(), d1 = law.delta1(), df = law.deltaf();
+  if (lambda <= d0) return law.k * lambda;
+  if (lambda <= d1) return law.sigma0;
+  if (lambda < df) return law.sigma0 * (df - lambda) / d0;
+  return 0.0;
+}
+
+// lambda = sqrt(<dn>_+^2 + dt1^2 + dt2^2)
+double effectiveSeparation(const Vec3& openingLocal) {
+  const double dnPos = std::max(openingLocal(0), 0.0);
+  return std::sqrt(dnPos * dnPos + openingLocal(1) * openingLocal(1) + openingLocal(2) * openingLocal(2));
+}
+
+// S = T(lambdaMax)/lambdaMax, with S = k on the elastic branch (also at lambdaMax = 0) and S = 0 once failed.
+double secantStiffness(const Law& law, double lambdaMax) {
+  if (lambdaMax <= law.delta0()) return law.k;
+  if (lambdaMax >= law.deltaf()) return 0.0;
+  return envelopeTraction(law, lambdaMax) / lambdaMax;
+}
+
+// lambdaMax <- max(lambdaMax, lambda)
+// t = S(lambdaMax) (<dn>_+, dt1, dt2) + (k min(dn, 0), 0, 0)
+// (S (<dn>_+, dt1, dt2) = T/lambda (<dn>_+, dt1, dt2) with T = S lambda, without dividing by lambda.)
+Vec3 computeTraction(const Law& law, const Vec3& openingLocal, double& lambdaMax) {
+  const double lambda = effectiveSeparation(openingLocal);
+  lambdaMax = std::max(lambdaMax, lambda);
+  const double S = secantStiffness(law, lambdaMax);
+  const double dn = openingLocal(0);
+  return Vec3(S * std::max(dn, 0.0) + law.k * std::min(dn, 0.0), S * openingLocal(1), S * openingLocal(2));
+}
+
+// W_stored = 0.5 S lambda^2 + 0.5 k <-dn>_+^2
+double storedEnergyDensity(const Law& law, const Vec3& openingLocal, double lambdaMax) {
+  const double lambda = effectiveSeparation(openingLocal);
+  const double S = secantStiffness(law, std::max(lambdaMax, lambda));
+  const double dnNeg = std::max(-openingLocal(0), 0.0);
+  return 0.5 * S * lambda * lambda + 0.5 * law.k * dnNeg * dnNeg;
+}
+
+// W_diss(lambdaMax) = int_0^lambdaMax T dlambda - 0.5 T(lambdaMax) lambdaMax; piecewise:
+//   elastic:   0
+//   plateau:   0.5 sigma0 delta0 + sigma0 (lambdaMax - delta0) - 0.5 sigma0 lambdaMax
+//   softening: Gamma - 0.5 T (deltaf - lambdaMax) - 0.5 T lambdaMax = Gamma - 0.5 T deltaf
+//   failed:    Gamma
+double dissipatedEnergyDensity(const Law& law, double lambdaMax) {
+  const double d0 = law.delta0(), d1 = law.delta1(), df = law.deltaf();
+  if (lambdaMax <= d0) return 0.0;
+  if (lambdaMax <= d1) return 0.5 * law.sigma0 * (lambdaMax - d0);
+  if (lambdaMax < df) return law.Gamma - 0.5 * envelopeTraction(law, lambdaMax) * df;
+  return law.Gamma;
+}
+
+// D = 1 - S/k
+double damage(const Law& law, double lambdaMax) { return 1.0 - secantStiffness(law, lambdaMax) / law.k; }
+bool isInelastic(const Law& law, double lambdaMax) { return lambdaMax > law.delta0(); }
+bool isFailed(const Law& law, double lambdaMax) { return lambdaMax >= law.deltaf(); }
+
+Mat3 makeFrame(const Vec3& normal) {
+  const Vec3 n = normal.normalized();
+  Vec3 t1 = Vec3::UnitX() - n.x() * n;  // e_x minus its normal part
+  if (t1.norm() < 1e-8) t1 = Vec3::UnitY() - n.y() * n;
+  t1.normalize();
+  Mat3 frame;
+  frame.row(0) = n.transpose();
+  frame.row(1) = t1.transpose();
+  frame.row(2) = n.cross(t1).transpose();
+  return frame;
+}
+
+// delta = (uB + thB x rB) - (uA + thA x rA)
+Vec3 computeOpening(const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA, const Vec3& uB, const Vec3& thB) {
+  return (uB + thB.cross(g.armB)) - (uA + thA.cross(g.armA));
+}
+
+// t = traction(R delta), F_B = -A R^T t, F_A = -F_B, M_A = rA x F_A, M_B = rB x F_B
+NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
+                                   const Vec3& uB, const Vec3& thB, double& lambdaMax) {
+  const Vec3 openingLocal = g.frame * computeOpening(g, uA, thA, uB, thB);
+  const Vec3 tLocal = computeTraction(law, openingLocal, lambdaMax);
+  const Vec3 forceB = -g.area * (g.frame.transpose() * tLocal);
+  const Vec3 forceA = -forceB;
+  return NodalWrench{forceA, g.armA.cross(forceA), forceB, g.armB.cross(forceB)};
+}
+
+// delta = Bq with B = [-I, [rA]x, I, -[rB]x] (theta x r = -[r]x theta), q = (uA, thA, uB, thB);
+// undamaged traction is k delta in every direction (tension: S = k; compression: contact k dn), so
+// f = -A B^T R^T (k R delta) = -k A B^T B q  =>  K = k A B^T B.
+Eigen::Matrix<double, 12, 12> elasticStiffness(const Law& law, const InterfaceGeometry& g) {
+  auto skew = [](const Vec3& r) {
+    Mat3 s;
+    s << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
+    return s;
+  };
+  Eigen::Matrix<double, 3, 12> B;
+  B << -Mat3::Identity(), skew(g.armA), Mat3::Identity(), -skew(g.armB);
+  return law.k * g.area * (B.transpose() * B);
+}
+
+}  // namespace enamel::cohesive

@@ -1,0 +1,79 @@
+#pragma once
+// Interface cohesive law (symmetric trapezoid) and the rigid-arm interface element, as pure functions.
+// DESIGN.md section 3 (Interfaces). Normalised units (d = 1, E_r = 1, rho_r = 1).
+#include <Eigen/Dense>
+
+namespace enamel::cohesive {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// Symmetric trapezoid fully set by (k, sigma0, Gamma): elastic to delta0 = sigma0/k, plateau to
+// delta1 = Gamma/sigma0, linear to zero at deltaf = delta1 + delta0 (area = Gamma). Requires delta1 >= delta0.
+struct Law {
+  double k, sigma0, Gamma;
+  double delta0() const;
+  double delta1() const;
+  double deltaf() const;
+};
+
+// throws std::invalid_argument (message names the quantity) if k, sigma0, Gamma not > 0 or Gamma < sigma0^2/k.
+Law makeLaw(double k, double sigma0, double Gamma);
+
+// Monotonic envelope T(lambda) of the effective traction for effective separation lambda >= 0.
+double envelopeTraction(const Law& law, double lambda);
+
+// Effective separation lambda = sqrt(<dn>_+^2 + dt1^2 + dt2^2) of a local opening (dn, dt1, dt2).
+double effectiveSeparation(const Vec3& openingLocal);
+
+// Secant stiffness S(lambdaMax) = envelope(lambdaMax)/lambdaMax; k while lambdaMax <= delta0, 0 once failed.
+double secantStiffness(const Law& law, double lambdaMax);
+
+// Traction (local n, t1, t2 components, tension positive) for a local opening, updating the history
+// variable lambdaMax (largest lambda reached; irreversible). Same law in every mode on lambda; secant
+// (damage) unloading: T = envelope(lambdaMax) * lambda / lambdaMax when lambda < lambdaMax (elastic k*lambda
+// while lambdaMax <= delta0); traction vector = T/lambda * (<dn>_+, dt1, dt2); plus penalty contact
+// k * min(dn, 0) on the normal component, always, even after failure. Failed (lambdaMax >= deltaf): zero
+// except contact.
+Vec3 computeTraction(const Law& law, const Vec3& openingLocal, double& lambdaMax);
+
+// Energy per unit area stored (recoverable) at this state: 0.5*S*lambda^2 + 0.5*k*<-dn>_+^2, S = secant stiffness.
+// S is evaluated at max(lambdaMax, lambda), i.e. at the history computeTraction would produce for this opening.
+double storedEnergyDensity(const Law& law, const Vec3& openingLocal, double lambdaMax);
+
+// Energy per unit area dissipated once lambdaMax has been reached: area under the envelope up to lambdaMax
+// minus the recoverable triangle 0.5*envelope(lambdaMax)*lambdaMax (0 while elastic, Gamma when failed).
+double dissipatedEnergyDensity(const Law& law, double lambdaMax);
+
+double damage(const Law& law, double lambdaMax);     // 1 - S/k, in [0,1]
+bool isInelastic(const Law& law, double lambdaMax);  // lambdaMax > delta0
+bool isFailed(const Law& law, double lambdaMax);     // lambdaMax >= deltaf
+
+// Interface element between node A and node B (rod centres in one slice; B may be a periodic image).
+// Massless; forces applied directly as equal and opposite nodal forces (never assembled into K).
+struct InterfaceGeometry {
+  Mat3 frame;   // rows: n (unit, from A towards B), t1, t2 (right-handed orthonormal)
+  Vec3 armA;    // midpoint of the shared Voronoi edge minus position of A
+  Vec3 armB;    // same midpoint minus position of B (B's image position for a periodic pair)
+  double area;  // A_i = h_e * l_i
+};
+
+// Right-handed orthonormal frame with rows (n, t1, t2) for a normal direction (need not be unit length):
+// t1 = the part of e_x orthogonal to n (the rod axis direction for an in-slice normal; e_y if n is along x),
+// t2 = n x t1.
+Mat3 makeFrame(const Vec3& normal);
+
+// Rigid-arm kinematics: opening (global frame) = (uB + thB x armB) - (uA + thA x armA).
+Vec3 computeOpening(const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA, const Vec3& uB, const Vec3& thB);
+
+struct NodalWrench { Vec3 forceA, momentA, forceB, momentB; };  // forces/moments exerted ON the nodes
+
+// Force on B = -area * frame^T * t_local; force on A = minus that; moments = arm x force.
+NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
+                                   const Vec3& uB, const Vec3& thB, double& lambdaMax);
+
+// Linearised (undamaged, elastic) interface stiffness 12x12 in the DOF order (uA, thA, uB, thB), k*area with
+// the rigid arms; used only to estimate frequencies / transverse modulus, never in the time loop.
+Eigen::Matrix<double, 12, 12> elasticStiffness(const Law& law, const InterfaceGeometry& g);
+
+}  // namespace enamel::cohesive

@@ -1,0 +1,122 @@
+#pragma once
+// Crossply geometry generator (DESIGN.md section 2).
+//
+// Axes: x = crack growth, y = loading (opening), z = ply stacking, periodic with period B = sqrt(3) d.
+// Two plies per period, each one row of rods: ply 1 at z = 0 with rods at +theta, ply 2 at z = t =
+// sqrt(3)/2 d with rods at -theta. Discrete yz-slices at x_k = k h_e carry one node per rod; beams join
+// consecutive nodes of a rod; interfaces join the nodes of two rods that are Voronoi neighbours in a slice
+// (periodic in z), with area h_e * l_i (l_i the shared Voronoi edge length).
+//
+// The model is plain arrays, one set per kind of thing (nodes, beams, interfaces), ready for explicit
+// loops and for deleting elements (the solver keeps alive flags; the geometry never changes afterwards).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "cohesive.hpp"
+
+namespace enamel {
+
+using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+
+/// What the generator needs; all lengths in units of d.
+struct GeometryParams {
+  double theta_deg = 30;         // decussation angle theta_D
+  double w_s = 32;               // specimen width (x)
+  double h_s = 16;               // specimen height (y)
+  double a0 = 16;                // pre-crack length, on the mid-plane y = h_s/2, from x = 0
+  double h_e = 0.3;              // requested slice spacing (adjusted so that w_s is a whole number of slices)
+  double crisscross_phase = 0;   // first crisscross point ahead of the tip at a0 + phase * d/sin(theta)
+  bool precrack = true;          // false: an uncracked block (used to measure the transverse modulus)
+};
+
+/// Interface tags (the layers drawn in Figs. 4-6, 8).
+enum InterfaceTag : std::int8_t {
+  kTagPly1 = 0,            // both rods in ply 1
+  kTagPly2 = 1,            // both rods in ply 2
+  kTagInterlayer12 = 2,    // ply 1 (z = 0) to ply 2 (z = t)
+  kTagInterlayer21 = 3,    // ply 2 (z = t) to ply 1 of the next period (z = B): the periodic wrap
+};
+const char* interfaceTagName(int tag);
+
+struct Model {
+  // --- geometry constants ---
+  double d = 1;
+  double theta = 0;        // radians
+  double s = 1;            // in-slice rod spacing d / cos(theta)
+  double t = 0;            // ply thickness sqrt(3)/2 d
+  double B = 0;            // z-period sqrt(3) d
+  double w_s = 0, h_s = 0, a0 = 0, h_e = 0;  // h_e is the slice spacing actually used
+  double yCrack = 0;       // mid-plane y = h_s / 2
+  double xCrisscross = 0;  // a crisscross point on the mid-plane (theta > 0)
+  int numSlices = 0;
+
+  // --- rods ---
+  std::vector<std::int8_t> rodPly;   // 0 = ply 1, 1 = ply 2
+  std::vector<int> rodIndex;         // j in y = yCrack + j s +/- (x - xCrisscross) tan(theta) (+/- d/4 at theta = 0)
+  Vec3 rodDirection(int ply) const;  // unit axis of the rods of a ply
+
+  // --- nodes (6 DOF each: ux uy uz rx ry rz) ---
+  std::vector<Vec3> X;               // reference positions, z in {0, t}
+  std::vector<int> nodeRod, nodeSlice;
+  std::vector<std::int8_t> nodePly;
+
+  // --- beam elements (rod segments between consecutive slices) ---
+  std::vector<std::array<int, 2>> beamNodes;
+  std::vector<int> beamRod;
+  double beamLength = 0;             // h_e / cos(theta), the same for all beams
+
+  // --- interface elements ---
+  std::vector<std::array<int, 2>> ifaceNodes;            // A, B (B possibly through the periodic wrap)
+  std::vector<cohesive::InterfaceGeometry> ifaceGeom;    // frame, arms, area
+  std::vector<std::int8_t> ifaceTag;
+  std::vector<int> ifaceSlice;
+  std::vector<double> ifaceEdgeLength;                   // l_i
+  std::vector<std::int8_t> ifaceZShift;                  // image of B used: z_B + shift * B
+
+  // --- boundary node sets (loaded in u_y): topmost / bottommost node of each ply in each slice ---
+  std::vector<int> topNodes, bottomNodes;
+
+  // --- removed by the pre-crack (not part of the model's elements; kept as crack-tracking seeds) ---
+  int precrackBeams = 0, precrackInterfaces = 0;
+  std::vector<std::array<int, 2>> precrackIfaceRods;  // rods of each removed interface
+  std::vector<int> precrackIfaceSlice;
+  std::vector<int> precrackBeamRod, precrackBeamSlice;  // rod and first slice of each removed beam
+
+  int numNodes() const { return static_cast<int>(X.size()); }
+  int numBeams() const { return static_cast<int>(beamNodes.size()); }
+  int numInterfaces() const { return static_cast<int>(ifaceNodes.size()); }
+  int numRods() const { return static_cast<int>(rodPly.size()); }
+  int numDofs() const { return 6 * numNodes(); }
+};
+
+/// y of the centre of rod j of a ply at position x (the analytic rod centre line).
+double rodCentreY(const Model& m, int ply, int j, double x);
+
+/// One Voronoi cell of a slice: polygon (in (y, z)) and the edges it shares with neighbours.
+struct VoronoiEdge {
+  int neighbour;       // index of the neighbouring point, or -1 for the specimen boundary (y = 0 or h_s)
+  int zShift;          // neighbour's image: z_neighbour + zShift * period
+  double length;
+  Vec2 midpoint;       // (y, z)
+};
+struct VoronoiCell {
+  std::vector<Vec2> polygon;     // counter-clockwise vertices (y, z)
+  std::vector<VoronoiEdge> edges;
+  double area = 0;
+  double perimeter = 0;
+};
+
+/// Voronoi tessellation of points (y, z) in the strip yLo <= y <= yHi, periodic in z with period `period`.
+/// Cells are clipped by the strip; edges shorter than minEdge are dropped (degenerate vertices).
+std::vector<VoronoiCell> computeSliceVoronoi(const std::vector<Vec2>& points, double period, double yLo,
+                                             double yHi, double minEdge = 1e-9);
+
+/// Build the whole crossply specimen. Throws std::invalid_argument on impossible parameters.
+Model buildCrossply(const GeometryParams& p);
+
+}  // namespace enamel

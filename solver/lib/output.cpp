@@ -1,0 +1,300 @@
+#include "output.hpp"
+
+#include <hdf5.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <functional>
+#include <numeric>
+#include <stdexcept>
+
+#include "strength.hpp"
+
+namespace enamel {
+
+Frame captureFrame(const Simulation& sim, double targetDa) {
+  Frame f;
+  f.targetDa = targetDa;
+  f.da = sim.state.crackAdvance;
+  f.step = sim.state.step;
+  f.time = sim.state.time;
+  f.appliedDisplacement = sim.state.appliedDisplacement;
+  f.nodeDisplacement.assign(sim.state.q.data(), sim.state.q.data() + sim.state.q.size());
+  const int ni = sim.model.numInterfaces();
+  f.ifaceDamage.resize(ni);
+  f.ifaceState.resize(ni);
+  for (int i = 0; i < ni; ++i) {
+    const double lm = sim.state.lambdaMax[i];
+    f.ifaceDamage[i] = static_cast<float>(cohesive::damage(sim.law, lm));
+    f.ifaceState[i] = cohesive::isFailed(sim.law, lm) ? 2 : cohesive::isInelastic(sim.law, lm) ? 1 : 0;
+  }
+  f.beamBroken = sim.state.beamBroken;
+  return f;
+}
+
+RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& R) {
+  RcurveSummary s;
+  if (da.empty()) return s;
+  s.R_init = R.front();
+  s.daMax = *std::max_element(da.begin(), da.end());
+  // R_ss: mean R over the last 20% of the advance reached (R at the largest advance, smoothed).
+  double sum = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < da.size(); ++i)
+    if (da[i] >= 0.8 * s.daMax) { sum += R[i]; ++n; }
+  s.R_ss = n ? sum / n : NAN;
+  // R_m, dR_m: mean and standard deviation of R over 0 < Delta_a/d < 30 (paper, Fig. 9).
+  std::vector<double> sel;
+  for (std::size_t i = 0; i < da.size(); ++i)
+    if (da[i] > 0 && da[i] < 30) sel.push_back(R[i]);
+  if (!sel.empty()) {
+    s.R_m = std::accumulate(sel.begin(), sel.end(), 0.0) / sel.size();
+    double var = 0;
+    for (double r : sel) var += (r - s.R_m) * (r - s.R_m);
+    s.dR_m = std::sqrt(var / sel.size());
+  }
+  return s;
+}
+
+namespace {
+
+// --- a thin RAII layer over the HDF5 C API ---
+struct Handle {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  Handle(hid_t i, herr_t (*c)(hid_t), const std::string& what) : id(i), close(c) {
+    if (id < 0) throw std::runtime_error("HDF5: cannot create " + what);
+  }
+  ~Handle() { if (id >= 0) close(id); }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+};
+
+void attr(hid_t obj, const char* name, const std::string& value) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "string type");
+  H5Tset_size(type.id, std::max<std::size_t>(1, value.size()));
+  H5Tset_cset(type.id, H5T_CSET_UTF8);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
+  Handle a(H5Acreate2(obj, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, name);
+  H5Awrite(a.id, type.id, value.empty() ? "" : value.c_str());
+}
+void attr(hid_t obj, const char* name, const char* value) { attr(obj, name, std::string(value)); }
+void attr(hid_t obj, const char* name, double value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
+  Handle a(H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, name);
+  H5Awrite(a.id, H5T_NATIVE_DOUBLE, &value);
+}
+void attr(hid_t obj, const char* name, long value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
+  Handle a(H5Acreate2(obj, name, H5T_NATIVE_LONG, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, name);
+  H5Awrite(a.id, H5T_NATIVE_LONG, &value);
+}
+
+template <class T> hid_t nativeType();
+template <> hid_t nativeType<double>() { return H5T_NATIVE_DOUBLE; }
+template <> hid_t nativeType<float>() { return H5T_NATIVE_FLOAT; }
+template <> hid_t nativeType<int>() { return H5T_NATIVE_INT; }
+template <> hid_t nativeType<long>() { return H5T_NATIVE_LONG; }
+template <> hid_t nativeType<std::uint8_t>() { return H5T_NATIVE_UINT8; }
+template <> hid_t nativeType<std::int8_t>() { return H5T_NATIVE_INT8; }
+
+// A dataset of rows x cols (cols = 1: 1-D) with a `unit` attribute (and an optional description).
+template <class T>
+void dataset(hid_t group, const char* name, const std::vector<T>& data, std::size_t cols, const std::string& unit,
+             const std::string& description = "") {
+  const hsize_t rows = cols ? data.size() / cols : 0;
+  hsize_t dims[2] = {rows, cols};
+  Handle space(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), H5Sclose, name);
+  Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list");
+  if (rows * cols > 4096) {  // compress large arrays
+    hsize_t chunk[2] = {std::min<hsize_t>(rows, std::max<hsize_t>(1, 65536 / cols)), cols};
+    H5Pset_chunk(plist.id, cols == 1 ? 1 : 2, chunk);
+    H5Pset_deflate(plist.id, 4);
+  }
+  Handle ds(H5Dcreate2(group, name, nativeType<T>(), space.id, H5P_DEFAULT, plist.id, H5P_DEFAULT), H5Dclose, name);
+  if (rows > 0) H5Dwrite(ds.id, nativeType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
+  attr(ds.id, "unit", unit);
+  if (!description.empty()) attr(ds.id, "description", description);
+}
+
+std::string utcNow() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+template <class F>
+std::vector<double> column(const std::vector<Measurement>& h, F f) {
+  std::vector<double> out;
+  out.reserve(h.size());
+  for (const auto& m : h) out.push_back(f(m));
+  return out;
+}
+
+}  // namespace
+
+void writeResultFile(const std::string& path, const Simulation& sim, const RunRecord& rec) {
+  const std::string tmp = path + ".tmp";
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become exceptions below, not stderr noise
+  {
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose, "file '" + tmp + "'");
+    const CaseParams& p = sim.params;
+    const Model& m = sim.model;
+    const double Gamma = p.Gamma();
+
+    // --- /meta: provenance and run status ---
+    {
+      Handle g(H5Gcreate2(file.id, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/meta");
+      attr(g.id, "case_toml", p.tomlText);
+      attr(g.id, "case_source", p.sourceName);
+      attr(g.id, "preset", p.presetName);
+      attr(g.id, "solver", "enamel-dem");
+      attr(g.id, "solver_version", ENAMEL_VERSION);
+      attr(g.id, "git_hash", ENAMEL_GIT_HASH);
+      attr(g.id, "integrator", sim.integrator->name());
+      attr(g.id, "linear_solver", p.linear_solver);
+      attr(g.id, "deletion_rule", p.deletion_rule);
+      attr(g.id, "seed", static_cast<long>(p.seed));
+      attr(g.id, "strength_generator", kStrengthGenerator);
+      attr(g.id, "status", rec.status);
+      attr(g.id, "stop_reason", rec.stopReason);
+      std::string warnings;
+      for (const auto& w : rec.warnings) warnings += w + "\n";
+      attr(g.id, "warnings", warnings);
+      attr(g.id, "wall_time_s", rec.wallSeconds);
+      attr(g.id, "steps", rec.steps);
+      attr(g.id, "written_utc", utcNow());
+      attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "
+                          "(time in d/c_r, c_r = sqrt(E_r/rho_r))");
+      attr(g.id, "dt", sim.integrator->timeStep());
+      attr(g.id, "E_transverse_over_Er", sim.E_transverse);
+      attr(g.id, "c_d_over_cr", sim.c_d);
+      attr(g.id, "rayleigh_a", sim.dampA);
+      attr(g.id, "rayleigh_b", sim.dampB);
+      attr(g.id, "omega_max_element", sim.omegaMaxElement);
+      attr(g.id, "v_app", sim.loading.vApp);
+      attr(g.id, "Gamma_i", Gamma);
+      attr(g.id, "sigma0", p.sigma0());
+      attr(g.id, "k", p.k());
+      attr(g.id, "sigma_ru_mean", p.sigma_ru());
+    }
+    // --- /rcurve ---
+    {
+      Handle g(H5Gcreate2(file.id, "rcurve", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/rcurve");
+      std::vector<double> R(rec.rcurveJ.size());
+      for (std::size_t i = 0; i < R.size(); ++i) R[i] = rec.rcurveJ[i] / Gamma;
+      dataset(g.id, "da_over_d", rec.rcurveDa, 1, "d", "crack advance Delta_a / d, one point per advance");
+      dataset(g.id, "R_over_Gamma", R, 1, "Gamma_i", "crack resistance J / Gamma_i at that advance");
+      const RcurveSummary s = summariseRcurve(rec.rcurveDa, R);
+      attr(g.id, "R_init_over_Gamma", s.R_init);
+      attr(g.id, "R_ss_over_Gamma", s.R_ss);
+      attr(g.id, "R_m_over_Gamma", s.R_m);
+      attr(g.id, "dR_m_over_Gamma", s.dR_m);
+      attr(g.id, "da_max_over_d", s.daMax);
+      attr(g.id, "definitions",
+           "R_init: first R with Delta_a > 0; R_ss: mean R over the last 20% of the advance reached; "
+           "R_m, dR_m: mean and standard deviation of R over 0 < Delta_a/d < 30");
+    }
+    // --- /history ---
+    {
+      Handle g(H5Gcreate2(file.id, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/history");
+      const auto& h = rec.history;
+      std::vector<long> steps;
+      for (const auto& r : h) steps.push_back(r.step);
+      dataset(g.id, "step", steps, 1, "-");
+      dataset(g.id, "time", column(h, [](auto& r) { return r.time; }), 1, "d/c_r");
+      dataset(g.id, "applied_displacement", column(h, [](auto& r) { return r.appliedDisplacement; }), 1, "d",
+              "u_y at the cracked edge of the top row (bottom row: minus this)");
+      dataset(g.id, "load", column(h, [](auto& r) { return r.load; }), 1, "E_r d^2",
+              "generalised force conjugate to applied_displacement");
+      dataset(g.id, "J_over_Gamma", column(h, [&](auto& r) { return r.J / Gamma; }), 1, "Gamma_i");
+      dataset(g.id, "da_over_d", column(h, [](auto& r) { return r.crackAdvance; }), 1, "d");
+      const char* eu = "E_r d^3 (per z-period B = sqrt(3) d)";
+      dataset(g.id, "kinetic_energy", column(h, [](auto& r) { return r.kinetic; }), 1, eu);
+      dataset(g.id, "strain_energy_beams", column(h, [](auto& r) { return r.strainBeams; }), 1, eu);
+      dataset(g.id, "strain_energy_interfaces", column(h, [](auto& r) { return r.strainInterfaces; }), 1, eu);
+      dataset(g.id, "damping_dissipation", column(h, [](auto& r) { return r.damping; }), 1, eu);
+      dataset(g.id, "fracture_dissipation_interfaces", column(h, [](auto& r) { return r.fracture; }), 1, eu);
+      dataset(g.id, "fracture_energy_rods", column(h, [](auto& r) { return r.rodFracture; }), 1, eu);
+      dataset(g.id, "external_work", column(h, [](auto& r) { return r.external; }), 1, eu);
+      dataset(g.id, "energy_balance_error", column(h, [](auto& r) { return r.balanceError; }), 1, "-",
+              "(external work - stored - kinetic - dissipated) / external work");
+      std::vector<int> broken, failed, inelastic;
+      for (const auto& r : h) { broken.push_back(r.brokenBeams); failed.push_back(r.failedInterfaces);
+                                inelastic.push_back(r.inelasticInterfaces); }
+      dataset(g.id, "broken_rod_elements", broken, 1, "count");
+      dataset(g.id, "failed_interfaces", failed, 1, "count");
+      dataset(g.id, "inelastic_interfaces", inelastic, 1, "count");
+    }
+    // --- /geometry ---
+    {
+      Handle g(H5Gcreate2(file.id, "geometry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/geometry");
+      std::vector<double> X;
+      for (const auto& x : m.X) X.insert(X.end(), {x.x(), x.y(), x.z()});
+      dataset(g.id, "node_position", X, 3, "d", "reference positions (x growth, y loading, z stacking)");
+      std::vector<int> ply(m.nodePly.begin(), m.nodePly.end());
+      dataset(g.id, "node_ply", ply, 1, "-", "0 = ply 1 (+theta), 1 = ply 2 (-theta)");
+      dataset(g.id, "node_rod", m.nodeRod, 1, "-");
+      dataset(g.id, "node_slice", m.nodeSlice, 1, "-");
+      std::vector<int> bn, in;
+      for (const auto& b : m.beamNodes) bn.insert(bn.end(), {b[0], b[1]});
+      for (const auto& b : m.ifaceNodes) in.insert(in.end(), {b[0], b[1]});
+      dataset(g.id, "beam_nodes", bn, 2, "-");
+      dataset(g.id, "beam_strength_over_sigma0", [&] {
+        std::vector<double> s(sim.beamStrength);
+        for (double& v : s) v /= p.sigma0();
+        return s; }(), 1, "sigma0");
+      dataset(g.id, "iface_nodes", in, 2, "-", "A, B; B through the z-wrap when iface_zshift = 1");
+      std::vector<int> tag(m.ifaceTag.begin(), m.ifaceTag.end()), zs(m.ifaceZShift.begin(), m.ifaceZShift.end());
+      dataset(g.id, "iface_tag", tag, 1, "-", "0 ply 1, 1 ply 2, 2 interlayer 1-2, 3 interlayer 2-1 (z-wrap)");
+      dataset(g.id, "iface_slice", m.ifaceSlice, 1, "-");
+      dataset(g.id, "iface_zshift", zs, 1, "B");
+      std::vector<double> area, mid;
+      for (int i = 0; i < m.numInterfaces(); ++i) {
+        area.push_back(m.ifaceGeom[i].area);
+        const Vec3 c = m.X[m.ifaceNodes[i][0]] + m.ifaceGeom[i].armA;
+        mid.insert(mid.end(), {c.x(), c.y(), c.z()});
+      }
+      dataset(g.id, "iface_area", area, 1, "d^2");
+      dataset(g.id, "iface_midpoint", mid, 3, "d", "centre of the shared Voronoi edge");
+      dataset(g.id, "top_nodes", m.topNodes, 1, "-");
+      dataset(g.id, "bottom_nodes", m.bottomNodes, 1, "-");
+      attr(g.id, "theta_D_deg", p.theta_D);
+      attr(g.id, "w_s", m.w_s);
+      attr(g.id, "h_s", m.h_s);
+      attr(g.id, "a0", m.a0);
+      attr(g.id, "h_e", m.h_e);
+      attr(g.id, "z_period_B", m.B);
+      attr(g.id, "ply_thickness", m.t);
+      attr(g.id, "y_crack_plane", m.yCrack);
+      attr(g.id, "x_crisscross", m.xCrisscross);
+      attr(g.id, "num_slices", static_cast<long>(m.numSlices));
+    }
+    // --- /frames ---
+    {
+      Handle g(H5Gcreate2(file.id, "frames", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames");
+      for (std::size_t i = 0; i < rec.frames.size(); ++i) {
+        const Frame& f = rec.frames[i];
+        const std::string name = std::to_string(i);
+        Handle fg(H5Gcreate2(g.id, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames/" + name);
+        attr(fg.id, "target_da_over_d", f.targetDa);
+        attr(fg.id, "da_over_d", f.da);
+        attr(fg.id, "step", f.step);
+        attr(fg.id, "time", f.time);
+        attr(fg.id, "applied_displacement", f.appliedDisplacement);
+        dataset(fg.id, "node_displacement", f.nodeDisplacement, 6, "d (rotations: rad)", "ux uy uz rx ry rz");
+        dataset(fg.id, "iface_damage", f.ifaceDamage, 1, "-", "1 - secant stiffness / k");
+        dataset(fg.id, "iface_state", f.ifaceState, 1, "-", "0 elastic, 1 inelastic (process zone), 2 failed");
+        dataset(fg.id, "beam_broken", f.beamBroken, 1, "-", "1 = rod element deleted");
+      }
+    }
+    if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("HDF5: cannot flush '" + tmp + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+}
+
+}  // namespace enamel

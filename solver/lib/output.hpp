@@ -1,0 +1,47 @@
+#pragma once
+// The result file: one self-describing HDF5 file per run (DESIGN section 6). Every dataset carries its
+// unit or normalisation as an attribute. The file is always written whole to `path.tmp` and renamed over
+// `path`, so a reader (or a run killed half-way) never sees a half-written file.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "simulation.hpp"
+
+namespace enamel {
+
+/// A snapshot of the damage state for the process-zone maps (Figs. 4-6, 8).
+struct Frame {
+  double targetDa = 0;   // the requested Delta_a / d (or -1 for the final state)
+  double da = 0;
+  long step = 0;
+  double time = 0, appliedDisplacement = 0;
+  std::vector<float> nodeDisplacement;      // N x 6
+  std::vector<float> ifaceDamage;           // 1 - S/k
+  std::vector<std::uint8_t> ifaceState;     // 0 elastic, 1 inelastic (process zone), 2 failed
+  std::vector<std::uint8_t> beamBroken;
+};
+
+struct RunRecord {
+  std::vector<Measurement> history;
+  std::vector<double> rcurveDa, rcurveJ;  // one point each time the crack advanced
+  std::vector<Frame> frames;
+  std::string status = "running";         // running | completed | failed | interrupted
+  std::string stopReason;                 // which criterion stopped it, or what went wrong
+  double wallSeconds = 0;
+  long steps = 0;
+  std::vector<std::string> warnings;      // quasi-static checks that left their bounds
+};
+
+Frame captureFrame(const Simulation& sim, double targetDa);
+
+/// Summary numbers of an R-curve (DESIGN section 5), normalised by Gamma_i.
+struct RcurveSummary {
+  double R_init = NAN, R_ss = NAN, R_m = NAN, dR_m = NAN, daMax = 0;
+};
+RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& RoverGamma);
+
+/// Write the whole result file atomically. Throws std::runtime_error naming the path on failure.
+void writeResultFile(const std::string& path, const Simulation& sim, const RunRecord& rec);
+
+}  // namespace enamel

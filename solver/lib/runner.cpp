@@ -1,0 +1,141 @@
+#include "runner.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <sstream>
+
+namespace enamel {
+
+namespace {
+volatile std::sig_atomic_t gStopSignal = 0;
+
+// Quasi-static and stability bounds (DESIGN section 4). Warnings are recorded in /meta/warnings;
+// the failure bound stops the run.
+constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
+constexpr double kBalanceFail = 0.25;      // ... above this: the run is unstable, stop
+constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
+constexpr double kBalanceMinWork = 1e-12;  // balance error is meaningless before any work was done
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0, double e = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b, c, d, e);
+  return buf;
+}
+}  // namespace
+
+void requestStop(int signal) { gStopSignal = signal; }
+
+RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(clock::now() - start).count(); };
+  const CaseParams& p = sim.params;
+  const double dt = sim.integrator->timeStep();
+  const double Gamma = p.Gamma();
+  const long historyEvery = p.history_every > 0
+      ? p.history_every : std::max(1L, std::lround(0.05 * sim.model.h_s / sim.c_d / dt));
+  const bool tty = isatty(STDERR_FILENO);
+
+  RunRecord rec;
+  std::size_t nextFrame = 0;
+  std::vector<double> frameTargets = p.frames_da_over_d;
+  std::sort(frameTargets.begin(), frameTargets.end());
+  double lastWrite = 0, lastProgress = 0, lastDa = 0;
+  bool warnedBalance = false, warnedKinetic = false;
+  auto save = [&] {
+    rec.wallSeconds = wall();
+    rec.steps = sim.state.step;
+    writeResultFile(opt.resultPath, sim, rec);
+    lastWrite = rec.wallSeconds;
+  };
+  auto fail = [&](const std::string& why) {
+    rec.status = "failed";
+    rec.stopReason = why;
+  };
+
+  rec.history.push_back(sim.measure());
+  save();
+  while (true) {
+    sim.step();
+    const State& s = sim.state;
+    // R-curve point each time the crack advanced.
+    if (s.crackAdvance > lastDa) {
+      lastDa = s.crackAdvance;
+      rec.rcurveDa.push_back(s.crackAdvance);
+      rec.rcurveJ.push_back(sim.computeJ());
+      while (nextFrame < frameTargets.size() && s.crackAdvance >= frameTargets[nextFrame])
+        rec.frames.push_back(captureFrame(sim, frameTargets[nextFrame++]));
+    }
+    // History, checks and progress every historyEvery steps.
+    if (s.step % historyEvery == 0) {
+      const Measurement r = sim.measure();
+      rec.history.push_back(r);
+      for (double x : {r.J, r.kinetic, r.strainBeams, r.strainInterfaces, r.external})
+        if (!std::isfinite(x)) {
+          fail(fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
+                   "the time step or the loading is unstable", s.step, s.time, r.J, r.kinetic, r.external));
+          break;
+        }
+      if (rec.status == "failed") break;
+      if (r.external > kBalanceMinWork && std::abs(r.balanceError) > kBalanceFail) {
+        fail(fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g): "
+                 "energy is created or lost; reduce dt_factor or the loading rate",
+                 r.balanceError, s.step, kBalanceFail, r.external));
+        break;
+      }
+      if (!warnedBalance && r.external > kBalanceMinWork && std::abs(r.balanceError) > kBalanceWarn) {
+        warnedBalance = true;
+        rec.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
+                                   kBalanceWarn));
+      }
+      const double strain = r.strainBeams + r.strainInterfaces;
+      if (!warnedKinetic && s.time > sim.loading.rampTime && strain > 0 && r.kinetic / strain > kKineticWarn) {
+        warnedKinetic = true;
+        rec.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
+                                   r.kinetic / strain, s.step, kKineticWarn));
+      }
+      const double w = wall();
+      if (opt.progress && (w - lastProgress > 2.0)) {
+        lastProgress = w;
+        const double U = s.appliedDisplacement;
+        const double frac = std::max({s.crackAdvance / p.stop_da_over_d, U / p.stop_u_over_d,
+                                      p.max_steps > 0 ? double(s.step) / p.max_steps : 0.0});
+        const double eta = frac > 1e-3 ? w * (1 - frac) / frac : NAN;
+        std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.0f steps/s  ETA %s%s",
+                     tty ? "\r" : "", s.step, s.time, U, s.crackAdvance, r.J / Gamma, s.brokenBeams, s.step / w,
+                     std::isfinite(eta) ? (std::to_string(static_cast<long>(eta)) + " s").c_str() : "?",
+                     tty ? "   " : "\n");
+      }
+      if (w - lastWrite > opt.writeIntervalSeconds) save();
+    }
+    // Stop criteria.
+    const double U = s.appliedDisplacement;
+    const double maxX = sim.model.a0 + s.crackAdvance;
+    if (s.crackAdvance >= p.stop_da_over_d)
+      rec.stopReason = fmt("crack advance %.3g d reached stop_da_over_d = %g", s.crackAdvance, p.stop_da_over_d);
+    else if (maxX >= sim.model.w_s - 2 * sim.model.h_e)
+      rec.stopReason = fmt("crack reached the far edge (x = %.3g d of w_s = %g d)", maxX, sim.model.w_s);
+    else if (U >= p.stop_u_over_d)
+      rec.stopReason = fmt("applied displacement %.4g d reached stop_u_over_d = %g", U, p.stop_u_over_d);
+    else if (p.max_steps > 0 && s.step >= p.max_steps)
+      rec.stopReason = fmt("step %.0f reached max_steps = %.0f", s.step, double(p.max_steps));
+    else if (gStopSignal)
+      rec.stopReason = fmt("interrupted by signal %.0f", gStopSignal);
+    if (!rec.stopReason.empty()) {
+      rec.status = gStopSignal ? "interrupted" : "completed";
+      break;
+    }
+  }
+  if (opt.progress && tty) std::fprintf(stderr, "\n");
+  if (rec.status != "failed" || rec.history.empty() || rec.history.back().step != sim.state.step)
+    rec.history.push_back(sim.measure());
+  rec.frames.push_back(captureFrame(sim, -1.0));
+  save();
+  return rec;
+}
+
+}  // namespace enamel

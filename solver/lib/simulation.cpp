@@ -1,0 +1,522 @@
+#include "simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/CholmodSupport>
+
+#include "integrators.hpp"
+#include "strength.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace enamel {
+
+namespace {
+
+GeometryParams geometryOf(const CaseParams& p) {
+  GeometryParams g;
+  g.theta_deg = p.theta_D;
+  g.w_s = p.w_s_over_d;
+  g.h_s = p.h_s_over_d;
+  g.a0 = p.a0();
+  g.h_e = p.h_e_over_d;
+  g.crisscross_phase = p.crisscross_phase;
+  return g;
+}
+
+beam::Section sectionOf(const CaseParams& p) {
+  return p.section == "circle" ? beam::circularSection(1.0, 1.0, p.nu_r, 1.0)
+                               : beam::hexagonalSection(1.0, 1.0, p.nu_r, 1.0);
+}
+
+// Unbreakable interfaces (verification runs) keep the elastic branch however far they open.
+cohesive::Law lawOf(const CaseParams& p) {
+  if (!p.interfaces_breakable) return cohesive::Law{p.k(), 1e300, 1e300};
+  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma());
+}
+
+beam::Vec12 gatherElement(const VecX& q, int a, int b) {
+  beam::Vec12 u;
+  u.head<6>() = q.segment<6>(6 * a);
+  u.tail<6>() = q.segment<6>(6 * b);
+  return u;
+}
+
+// Add (sign x) a 12x12 element matrix into a triplet list / an existing sparse pattern.
+void addElementTriplets(std::vector<Eigen::Triplet<double>>& trip, const beam::Mat12& Ke, int a, int b) {
+  const int dof[2] = {6 * a, 6 * b};
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      trip.emplace_back(dof[i / 6] + i % 6, dof[j / 6] + j % 6, Ke(i, j));
+}
+
+void addElementInPlace(SpMat& A, const beam::Mat12& Ke, int a, int b, double sign) {
+  const int dof[2] = {6 * a, 6 * b};
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) A.coeffRef(dof[i / 6] + i % 6, dof[j / 6] + j % 6) += sign * Ke(i, j);
+}
+
+SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perPly, int nDofs) {
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(static_cast<std::size_t>(m.numBeams()) * 144);
+  for (int e = 0; e < m.numBeams(); ++e)
+    addElementTriplets(trip, perPly[m.rodPly[m.beamRod[e]]], m.beamNodes[e][0], m.beamNodes[e][1]);
+  SpMat A(nDofs, nDofs);
+  A.setFromTriplets(trip.begin(), trip.end());
+  return A;
+}
+
+}  // namespace
+
+// --- loading -------------------------------------------------------------------------------------------
+double Loading::velocity(double t) const {
+  if (t >= rampTime) return vApp;
+  return vApp * 0.5 * (1.0 - std::cos(M_PI * t / rampTime));
+}
+double Loading::displacement(double t) const {
+  if (rampTime <= 0) return vApp * t;
+  if (t >= rampTime) return vApp * (0.5 * rampTime + (t - rampTime));
+  return vApp * (0.5 * t - rampTime / (2 * M_PI) * std::sin(M_PI * t / rampTime));
+}
+double Loading::acceleration(double t) const {
+  if (t >= rampTime) return 0.0;
+  return vApp * 0.5 * M_PI / rampTime * std::sin(M_PI * t / rampTime);
+}
+
+// --- static elastic solutions (verification, transverse modulus) ----------------------------------------
+VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<double> uPres(n, 0.0);
+  std::vector<int> freeIdx(n, 0);
+  for (std::size_t i = 0; i < dofs.size(); ++i) { freeIdx[dofs[i]] = -1; uPres[dofs[i]] = values[i]; }
+  int nf = 0;
+  for (int i = 0; i < n; ++i)
+    if (freeIdx[i] == 0) freeIdx[i] = nf++;
+  std::vector<Eigen::Triplet<double>> tff;
+  VecX rhs = VecX::Zero(nf);
+  for (int c = 0; c < K.outerSize(); ++c)
+    for (SpMat::InnerIterator it(K, c); it; ++it) {
+      const int r = static_cast<int>(it.row());
+      if (freeIdx[r] < 0) continue;
+      if (freeIdx[c] >= 0) tff.emplace_back(freeIdx[r], freeIdx[c], it.value());
+      else rhs[freeIdx[r]] -= it.value() * uPres[c];
+    }
+  SpMat Kff(nf, nf);
+  Kff.setFromTriplets(tff.begin(), tff.end());
+  Eigen::CholmodSupernodalLLT<SpMat> chol(Kff);
+  if (chol.info() != Eigen::Success) throw std::runtime_error("static solve: stiffness factorisation failed");
+  const VecX uf = chol.solve(rhs);
+  VecX u(n);
+  for (int i = 0; i < n; ++i) u[i] = freeIdx[i] >= 0 ? uf[freeIdx[i]] : uPres[i];
+  return u;
+}
+
+SpMat assembleElasticStiffness(const Model& m, const std::vector<beam::Mat12>& beamKPerPly,
+                               const std::vector<std::uint8_t>* beamBroken, const cohesive::Law& law) {
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int e = 0; e < m.numBeams(); ++e)
+    if (!beamBroken || !(*beamBroken)[e])
+      addElementTriplets(trip, beamKPerPly[m.rodPly[m.beamRod[e]]], m.beamNodes[e][0], m.beamNodes[e][1]);
+  for (int i = 0; i < m.numInterfaces(); ++i)
+    addElementTriplets(trip, cohesive::elasticStiffness(law, m.ifaceGeom[i]), m.ifaceNodes[i][0], m.ifaceNodes[i][1]);
+  SpMat K(m.numDofs(), m.numDofs());
+  K.setFromTriplets(trip.begin(), trip.end());
+  return K;
+}
+
+// --- transverse modulus ----------------------------------------------------------------------------------
+double measureTransverseModulus(const CaseParams& p, double* blockStrain) {
+  GeometryParams g = geometryOf(p);
+  g.h_s = std::min(p.h_s_over_d, 12.0);
+  g.w_s = std::min(p.w_s_over_d, 24.0);
+  g.a0 = 0.5 * g.w_s;
+  g.precrack = false;
+  const Model m = buildCrossply(g);
+  const beam::Section sec = sectionOf(p);
+  const cohesive::Law law = lawOf(p);
+  std::vector<beam::Mat12> Kply(2);
+  for (int ply = 0; ply < 2; ++ply)
+    Kply[ply] = beam::globalStiffness(sec, Vec3::Zero(), m.beamLength * m.rodDirection(ply));
+  const SpMat K = assembleElasticStiffness(m, Kply, nullptr, law);
+
+  // Prescribed: u_y = +delta/2 on the top rows, -delta/2 on the bottom rows; u_x = u_z = 0 at one node.
+  const double delta = 1e-3;
+  std::vector<int> dofs;
+  std::vector<double> values;
+  for (int node : m.topNodes) { dofs.push_back(6 * node + 1); values.push_back(0.5 * delta); }
+  for (int node : m.bottomNodes) { dofs.push_back(6 * node + 1); values.push_back(-0.5 * delta); }
+  dofs.insert(dofs.end(), {6 * m.bottomNodes[0], 6 * m.bottomNodes[0] + 2});
+  values.insert(values.end(), {0.0, 0.0});
+  const VecX u = solveStaticPrescribed(K, dofs, values);
+  const VecX f = K * u;
+  double P = 0;
+  for (int node : m.topNodes) P += f[6 * node + 1];
+  // Height between the mean top and bottom rows; area = w_s (the slices' total tributary length) x B.
+  double yTop = 0, yBot = 0;
+  for (int node : m.topNodes) yTop += m.X[node].y();
+  for (int node : m.bottomNodes) yBot += m.X[node].y();
+  yTop /= m.topNodes.size();
+  yBot /= m.bottomNodes.size();
+  const double strain = delta / (yTop - yBot);
+  if (blockStrain) *blockStrain = strain;
+  return P / (m.w_s * m.B) / strain;
+}
+
+// --- set-up ---------------------------------------------------------------------------------------------
+Simulation::Simulation(const CaseParams& p)
+    : params(p), model(buildCrossply(geometryOf(p))), section(sectionOf(p)), law(lawOf(p)) {
+  const Model& m = model;
+  const int n = m.numDofs();
+
+  // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
+  beamStrength = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
+  if (!p.rods_breakable) std::fill(beamStrength.begin(), beamStrength.end(), INFINITY);
+
+  // Element matrices: all rods of a ply share one orientation, so one matrix per ply.
+  for (int ply = 0; ply < 2; ++ply) {
+    const Vec3 xb = m.beamLength * m.rodDirection(ply);
+    const beam::Mat3 R = beam::localFrame(Vec3::Zero(), xb);
+    beamK.push_back(beam::globalStiffness(section, Vec3::Zero(), xb));
+    beamMc.push_back(beam::globalConsistentMass(section, Vec3::Zero(), xb));
+    beam::Mat12 T = beam::Mat12::Zero();
+    for (int blk = 0; blk < 4; ++blk) T.block<3, 3>(3 * blk, 3 * blk) = R;
+    beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
+  }
+  K = assembleBeams(m, beamK, n);
+  M = assembleBeams(m, beamMc, n);
+  omegaMaxElement = beam::maxFrequency(section, m.beamLength, beam::MassKind::Consistent);
+
+  // Wave speed and Rayleigh damping (paper eq. 1-3, DESIGN section 4): C = a M + b K,
+  // a = zeta w_min, b = zeta / w_min, w_min = pi c_d / h_s.
+  E_transverse = p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p);
+  c_d = std::sqrt(E_transverse / 1.0);
+  omegaMin = M_PI * c_d / m.h_s;
+  dampA = p.zeta * omegaMin;
+  dampB = p.zeta / omegaMin;
+  loading.vApp = p.v_app_over_cd * c_d;
+  loading.rampTime = p.ramp_transits * m.h_s / c_d;
+
+  // Prescribed DOFs: u_y of the top (+) and bottom (-) rows, graded 1 - x/w_s.
+  dofToFree.assign(n, 0);
+  auto prescribe = [&](const std::vector<int>& nodes, double sign) {
+    for (int node : nodes) {
+      prescribedDofs.push_back(6 * node + 1);
+      prescribedShape.push_back(sign * (1.0 - m.X[node].x() / m.w_s));
+      dofToFree[6 * node + 1] = -1;
+    }
+  };
+  prescribe(m.topNodes, +1.0);
+  prescribe(m.bottomNodes, -1.0);
+  for (int i = 0; i < n; ++i)
+    if (dofToFree[i] == 0) { dofToFree[i] = static_cast<int>(freeDofs.size()); freeDofs.push_back(i); }
+
+  // Node -> interface ends (CSR), for the deterministic gather.
+  nodeIfaceStart.assign(m.numNodes() + 1, 0);
+  for (const auto& ab : m.ifaceNodes) { ++nodeIfaceStart[ab[0] + 1]; ++nodeIfaceStart[ab[1] + 1]; }
+  for (int i = 0; i < m.numNodes(); ++i) nodeIfaceStart[i + 1] += nodeIfaceStart[i];
+  nodeIfaceList.resize(nodeIfaceStart.back());
+  std::vector<int> fill(nodeIfaceStart.begin(), nodeIfaceStart.end() - 1);
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    nodeIfaceList[fill[m.ifaceNodes[i][0]]++] = 2 * i;
+    nodeIfaceList[fill[m.ifaceNodes[i][1]]++] = 2 * i + 1;
+  }
+
+  state.q = VecX::Zero(n);
+  state.v = VecX::Zero(n);
+  state.a = VecX::Zero(n);
+  state.lambdaMax.assign(m.numInterfaces(), 0.0);
+  state.beamBroken.assign(m.numBeams(), 0);
+  reaction = VecX::Zero(prescribedDofs.size());
+  deletionRule = p.deletion_rule;
+
+#ifdef _OPENMP
+  // threads = 0: automatic, one thread per 30k DOF up to all cores (small models run faster on one).
+  omp_set_num_threads(p.threads > 0 ? static_cast<int>(p.threads)
+                                    : std::max(1, std::min(omp_get_num_procs(), n / 30000)));
+#endif
+  integrator = makeIntegrator(*this);
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::solveStaticElastic(double U) {
+  const SpMat Kt = assembleElasticStiffness(model, beamK, &state.beamBroken, law);
+  std::vector<int> dofs = prescribedDofs;
+  std::vector<double> values;
+  for (double sh : prescribedShape) values.push_back(sh * U);
+  const int anchor = model.bottomNodes[0];  // against rigid translation in x and z
+  dofs.insert(dofs.end(), {6 * anchor, 6 * anchor + 2});
+  values.insert(values.end(), {0.0, 0.0});
+  state.q = solveStaticPrescribed(Kt, dofs, values);
+  state.v.setZero();
+  state.a.setZero();
+  state.appliedDisplacement = U;
+  const VecX f = Kt * state.q;
+  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) reaction[i] = f[prescribedDofs[i]];
+}
+
+// --- kernels -------------------------------------------------------------------------------------------
+void Simulation::applyBoundaryConditions(double t) {
+  const double U = loading.displacement(t), V = loading.velocity(t), A = loading.acceleration(t);
+  state.appliedDisplacement = U;
+  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) {
+    state.q[prescribedDofs[i]] = prescribedShape[i] * U;
+    state.v[prescribedDofs[i]] = prescribedShape[i] * V;
+    state.a[prescribedDofs[i]] = prescribedShape[i] * A;
+  }
+}
+
+void Simulation::computeForcesForInterfaces(const VecX& q, VecX& f, bool update) {
+  const Model& m = model;
+  const int ni = m.numInterfaces();
+  std::vector<cohesive::NodalWrench>& wrench = ifaceWrench;
+  wrench.resize(ni);
+  int failed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : failed)
+  for (int i = 0; i < ni; ++i) {
+    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+    double lm = state.lambdaMax[i];
+    wrench[i] = cohesive::computeInterfaceForces(law, m.ifaceGeom[i], q.segment<3>(6 * A), q.segment<3>(6 * A + 3),
+                                                 q.segment<3>(6 * B), q.segment<3>(6 * B + 3), lm);
+    if (update) state.lambdaMax[i] = lm;
+    failed += cohesive::isFailed(law, lm);
+  }
+  if (update) state.failedInterfaces = failed;
+  // f_iface = -(forces exerted on the nodes), gathered per node in the fixed CSR order.
+#pragma omp parallel for schedule(static)
+  for (int node = 0; node < m.numNodes(); ++node) {
+    Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
+    for (int k = nodeIfaceStart[node]; k < nodeIfaceStart[node + 1]; ++k) {
+      const auto& w = wrench[nodeIfaceList[k] >> 1];
+      if (nodeIfaceList[k] & 1) { F += w.forceB; Mo += w.momentB; }
+      else { F += w.forceA; Mo += w.momentA; }
+    }
+    f.segment<3>(6 * node) = -F;
+    f.segment<3>(6 * node + 3) = -Mo;
+  }
+}
+
+void Simulation::computeStressRatiosForBeams(const VecX& q, std::vector<double>& ratio) const {
+  const Model& m = model;
+  ratio.assign(m.numBeams(), 0.0);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < m.numBeams(); ++e) {
+    if (state.beamBroken[e]) continue;
+    const beam::Vec12 fl = beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
+                           gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
+    ratio[e] = beam::maxTensileStress(section, fl) / beamStrength[e];
+  }
+}
+
+// Deletion rule (DESIGN section 3), independent of element order and thread count:
+//  "most_overloaded": delete the element(s) with the largest stress ratio >= 1, ties within 1e-9
+//                     relative (mirror-symmetric rods) deleted together; the rest are re-evaluated next step.
+//  "all":             delete every element with ratio >= 1.
+// A deleted element's stiffness (and its stiffness damping) is removed; its consistent mass is replaced by
+// the lumped mass of the same element, so no material mass vanishes and no node is left massless (the paper
+// subtracts M_e, eq. 17; see README "Model"). The strain energy it held, and the kinetic energy change of
+// the mass lumping, are booked as rod fracture energy.
+int Simulation::deleteOverloadedBeams() {
+  lastDeleted.clear();
+  if (!params.rods_breakable) return 0;
+  std::vector<double>& ratio = beamStressRatio;
+  computeStressRatiosForBeams(state.q, ratio);
+  double worst = 0;
+  for (double r : ratio) worst = std::max(worst, r);
+  if (worst < 1.0) return 0;
+  const double threshold = deletionRule == "all" ? 1.0 : worst * (1.0 - 1e-9);
+  for (int e = 0; e < model.numBeams(); ++e)
+    if (!state.beamBroken[e] && ratio[e] >= threshold) lastDeleted.push_back(e);
+  for (int e : lastDeleted) {
+    const int a = model.beamNodes[e][0], b = model.beamNodes[e][1];
+    const int ply = model.rodPly[model.beamRod[e]];
+    const beam::Vec12 u = gatherElement(state.q, a, b), v = gatherElement(state.v, a, b);
+    const beam::Mat12 Ml = beam::rotateToGlobal(
+        beam::lumpedMassDiagonal(section, model.beamLength).asDiagonal().toDenseMatrix(),
+        beam::localFrame(Vec3::Zero(), model.rodDirection(ply)));
+    state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u) + 0.5 * v.dot((beamMc[ply] - Ml) * v);
+    addElementInPlace(K, beamK[ply], a, b, -1.0);
+    addElementInPlace(M, beamMc[ply] - Ml, a, b, -1.0);
+    state.beamBroken[e] = 1;
+    ++state.brokenBeams;
+  }
+  integrator->onBeamsDeleted(*this);
+  return static_cast<int>(lastDeleted.size());
+}
+
+/// One time step: advance positions, boundary conditions, forces for beams and interfaces, accelerations and
+/// velocities (the integrator); delete overloaded rods; track the crack when something broke.
+void Simulation::step() {
+  const int failedBefore = state.failedInterfaces;
+  integrator->advance(*this);
+  const int deleted = deleteOverloadedBeams();
+  if (deleted > 0 || state.failedInterfaces != failedBefore) state.crackAdvance = measureCrackAdvance();
+}
+
+// --- measurements ---------------------------------------------------------------------------------------
+double Simulation::strainEnergyOfBeams() const { return 0.5 * state.q.dot(K * state.q); }
+
+double Simulation::strainEnergyOfInterfaces() const {
+  const Model& m = model;
+  double sum = 0;
+#pragma omp parallel for schedule(static) reduction(+ : sum)
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+    const auto& g = m.ifaceGeom[i];
+    const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
+                                                         state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
+    sum += g.area * cohesive::storedEnergyDensity(law, open, state.lambdaMax[i]);
+  }
+  return sum;
+}
+
+double Simulation::fractureEnergyOfInterfaces() const {
+  double sum = 0;
+  for (int i = 0; i < model.numInterfaces(); ++i)
+    sum += model.ifaceGeom[i].area * cohesive::dissipatedEnergyDensity(law, state.lambdaMax[i]);
+  return sum;
+}
+
+int Simulation::countFailedInterfaces() const {
+  int n = 0;
+  for (double lm : state.lambdaMax) n += cohesive::isFailed(law, lm);
+  return n;
+}
+
+int Simulation::countInelasticInterfaces() const {
+  int n = 0;
+  for (double lm : state.lambdaMax) n += cohesive::isInelastic(law, lm);
+  return n;
+}
+
+// J at the outer boundary (DESIGN section 5), per unit thickness B:
+//   J = (1/B) [ - sum_{loaded nodes} F_y (du_y/dx)  +  W_right - W_left ]
+// with F_y the force the grips apply, du_y/dx = -/+ U / w_s on the top/bottom rows, and W the strain energy
+// per unit length in x at the free left and right faces (first slice: beams of the first segment over h_e,
+// interfaces of the end slice over their tributary h_e / 2).
+double Simulation::computeJ() const {
+  const Model& m = model;
+  const double U = state.appliedDisplacement;
+  double sumFdudx = 0;
+  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) {
+    const double dudx = prescribedShape[i] >= 0 ? -U / m.w_s : U / m.w_s;
+    sumFdudx += reaction[i] * dudx;
+  }
+  auto faceEnergyDensity = [&](int slice, int segment) {
+    double eb = 0, ei = 0;
+    for (int e = 0; e < m.numBeams(); ++e) {
+      if (state.beamBroken[e] || m.nodeSlice[m.beamNodes[e][0]] != segment) continue;
+      const beam::Vec12 u = gatherElement(state.q, m.beamNodes[e][0], m.beamNodes[e][1]);
+      eb += 0.5 * u.dot(beamK[m.rodPly[m.beamRod[e]]] * u);
+    }
+    for (int i = 0; i < m.numInterfaces(); ++i) {
+      if (m.ifaceSlice[i] != slice) continue;
+      const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+      const auto& g = m.ifaceGeom[i];
+      const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
+                                                           state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
+      ei += g.area * cohesive::storedEnergyDensity(law, open, state.lambdaMax[i]);
+    }
+    return eb / m.h_e + ei / (0.5 * m.h_e);
+  };
+  const double Wleft = faceEnergyDensity(0, 0);
+  const double Wright = faceEnergyDensity(m.numSlices - 1, m.numSlices - 2);
+  return (-sumFdudx + Wright - Wleft) / m.B;
+}
+
+// Crack tip (DESIGN section 5): the connected cluster of failed interfaces and deleted rod elements that
+// touches the pre-crack. Each element touches (rod, slice) points (an interface: its two rods in its slice;
+// a rod element: its rod at its two slices); two elements are connected when they touch the same rod in the
+// same or adjacent slices. Delta_a = max x over the cluster - a0 (projected on x); daughter cracks do not count.
+double Simulation::measureCrackAdvance() const {
+  const Model& m = model;
+  const int ns = m.numSlices;
+  struct Touch { long key; int elem; };
+  std::vector<Touch> touches;
+  std::vector<double> elemX;
+  std::vector<char> seed;
+  auto addElem = [&](double x, bool isSeed, std::initializer_list<std::pair<int, int>> pts) {
+    const int id = static_cast<int>(elemX.size());
+    elemX.push_back(x);
+    seed.push_back(isSeed);
+    for (auto [rod, slice] : pts) touches.push_back({static_cast<long>(rod) * ns + slice, id});
+  };
+  for (std::size_t i = 0; i < m.precrackIfaceRods.size(); ++i)
+    addElem(m.precrackIfaceSlice[i] * m.h_e, true,
+            {{m.precrackIfaceRods[i][0], m.precrackIfaceSlice[i]}, {m.precrackIfaceRods[i][1], m.precrackIfaceSlice[i]}});
+  for (std::size_t i = 0; i < m.precrackBeamRod.size(); ++i)
+    addElem((m.precrackBeamSlice[i] + 0.5) * m.h_e, true,
+            {{m.precrackBeamRod[i], m.precrackBeamSlice[i]}, {m.precrackBeamRod[i], m.precrackBeamSlice[i] + 1}});
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    if (!cohesive::isFailed(law, state.lambdaMax[i])) continue;
+    const int k = m.ifaceSlice[i];
+    addElem(k * m.h_e, false, {{m.nodeRod[m.ifaceNodes[i][0]], k}, {m.nodeRod[m.ifaceNodes[i][1]], k}});
+  }
+  for (int e = 0; e < m.numBeams(); ++e) {
+    if (!state.beamBroken[e]) continue;
+    const int k = m.nodeSlice[m.beamNodes[e][0]];
+    addElem((k + 0.5) * m.h_e, false, {{m.beamRod[e], k}, {m.beamRod[e], k + 1}});
+  }
+  std::sort(touches.begin(), touches.end(), [](const Touch& x, const Touch& y) {
+    return x.key < y.key || (x.key == y.key && x.elem < y.elem);
+  });
+  std::vector<std::vector<int>> elemTouches(elemX.size());
+  for (const Touch& t : touches) elemTouches[t.elem].push_back(static_cast<int>(t.key));
+  auto range = [&](long key) {
+    auto lo = std::lower_bound(touches.begin(), touches.end(), key, [](const Touch& t, long k) { return t.key < k; });
+    auto hi = lo;
+    while (hi != touches.end() && hi->key == key) ++hi;
+    return std::make_pair(lo, hi);
+  };
+  std::vector<char> visited(elemX.size(), 0);
+  std::vector<int> stack;
+  for (std::size_t i = 0; i < elemX.size(); ++i)
+    if (seed[i]) { visited[i] = 1; stack.push_back(static_cast<int>(i)); }
+  double maxX = 0;
+  while (!stack.empty()) {
+    const int e = stack.back();
+    stack.pop_back();
+    maxX = std::max(maxX, elemX[e]);
+    for (int key : elemTouches[e]) {
+      const int slice = key % ns;
+      for (int dk = -1; dk <= 1; ++dk) {
+        if (slice + dk < 0 || slice + dk >= ns) continue;
+        auto [lo, hi] = range(key + dk);
+        for (auto it = lo; it != hi; ++it)
+          if (!visited[it->elem]) { visited[it->elem] = 1; stack.push_back(it->elem); }
+      }
+    }
+  }
+  return std::max(0.0, maxX - m.a0);
+}
+
+Measurement Simulation::measure() {
+  Measurement r;
+  r.step = state.step;
+  r.time = state.time;
+  r.appliedDisplacement = state.appliedDisplacement;
+  r.J = computeJ();
+  r.crackAdvance = state.crackAdvance;
+  r.kinetic = integrator->kineticEnergy(*this);
+  r.strainBeams = strainEnergyOfBeams();
+  r.strainInterfaces = strainEnergyOfInterfaces();
+  r.damping = state.dampingWork;
+  r.fracture = fractureEnergyOfInterfaces();
+  r.rodFracture = state.rodFractureEnergy;
+  r.external = state.externalWork;
+  const double stored = r.kinetic + r.strainBeams + r.strainInterfaces + r.damping + r.fracture + r.rodFracture;
+  r.balanceError = r.external > 0 ? (r.external - stored) / r.external : 0.0;
+  r.brokenBeams = state.brokenBeams;
+  r.failedInterfaces = countFailedInterfaces();
+  r.inelasticInterfaces = countInelasticInterfaces();
+  double P = 0;
+  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) P += reaction[i] * prescribedShape[i];
+  r.load = P;
+  return r;
+}
+
+}  // namespace enamel

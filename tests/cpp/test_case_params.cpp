@@ -1,0 +1,411 @@
+// Case-file parsing: one test per error class (exit code + a message naming key, value, range),
+// the layering order, the key table's own consistency, and round-tripping the effective case.
+#include "case_params.hpp"
+#include "exit_codes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef ENAMEL_SOURCE_DIR
+#define ENAMEL_SOURCE_DIR "."  // standalone compile: run from the repository root
+#endif
+
+using enamel::CaseError;
+using enamel::CaseParams;
+using enamel::KeySpec;
+using enamel::Kind;
+using enamel::parseCase;
+namespace exit_code = enamel::exit_code;
+
+namespace {
+
+// The three required physics keys.
+const std::string kPhysics = "theta_D = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n";
+
+CaseParams parse(const std::string& extra, const std::string& preset = "",
+                 const std::vector<std::string>& sets = {}) {
+    return parseCase(kPhysics + extra, "case.toml", preset, sets);
+}
+
+// Run f, which must throw CaseError; return it.
+CaseError caseErrorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const CaseError& e) {
+        return e;
+    }
+    ADD_FAILURE() << "expected a CaseError";
+    return CaseError(-1, "");
+}
+
+// The message is one line and contains every piece.
+void expectMessage(const CaseError& e, const std::vector<std::string>& pieces) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    for (const std::string& p : pieces) EXPECT_NE(m.find(p), std::string::npos) << "'" << p << "' not in: " << m;
+}
+
+std::string writeTempFile(const std::string& name, const std::string& text) {
+    const std::string path = ::testing::TempDir() + name;
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return path;
+    std::fwrite(text.data(), 1, text.size(), f);
+    std::fclose(f);
+    return path;
+}
+
+// Lines of a TOML text that are not comments or blank: the key = value part.
+std::string keyLines(const std::string& toml) {
+    std::istringstream in(toml);
+    std::string line, out;
+    while (std::getline(in, line))
+        if (!line.empty() && line[0] != '#') out += line + "\n";
+    return out;
+}
+
+}  // namespace
+
+// Derived quantities are exact arithmetic on the inputs: compare to 1e-12 relative (rounding only).
+constexpr double kArithmeticTol = 1e-12;
+
+TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
+    const CaseParams p = parse("");
+    EXPECT_EQ(p.theta_D, 30.0);
+    EXPECT_EQ(p.Er_over_kd, 10.0);
+    EXPECT_EQ(p.sigma_ru_over_sigma0, 21.4);
+    EXPECT_EQ(p.cv, 0.0);
+    EXPECT_EQ(p.Gamma_k_over_sigma0sq, 3.0);
+    EXPECT_EQ(p.section, "hexagon");
+    EXPECT_EQ(p.seed, 1);
+    EXPECT_TRUE(p.rods_breakable);
+    EXPECT_TRUE(p.interfaces_breakable);
+    EXPECT_EQ(p.w_s_over_d, 32.0);
+    EXPECT_EQ(p.h_s_over_d, 16.0);
+    EXPECT_EQ(p.h_e_over_d, 0.3);
+    EXPECT_EQ(p.integrator, "paper");
+    EXPECT_EQ(p.linear_solver, "cholmod");
+    EXPECT_EQ(p.deletion_rule, "most_overloaded");
+    EXPECT_EQ(p.max_steps, 0);
+    EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{5, 15, 30}));
+    EXPECT_EQ(p.sourceName, "case.toml");
+    EXPECT_EQ(p.presetName, "");
+    // k = 1/10, sigma0 = 1e-3 k, Gamma = 3 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
+    EXPECT_NEAR(p.k(), 0.1, kArithmeticTol * 0.1);
+    EXPECT_NEAR(p.sigma0(), 1e-4, kArithmeticTol * 1e-4);
+    EXPECT_NEAR(p.Gamma(), 3e-7, kArithmeticTol * 3e-7);
+    EXPECT_NEAR(p.sigma_ru(), 21.4e-4, kArithmeticTol * 21.4e-4);
+    EXPECT_NEAR(p.a0(), 16.0, kArithmeticTol * 16.0);
+}
+
+TEST(CaseParams, UnknownKeySuggestsClosestKey) {
+    const auto e = caseErrorOf([] {
+        parseCase("theta = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", "case.toml", "", {});
+    });
+    EXPECT_EQ(e.exitCode, exit_code::unknown_key);
+    EXPECT_STREQ(e.what(), "case.toml: unknown key 'theta' (did you mean 'theta_D'? 'enamel-dem keys' lists all keys)");
+    // Nothing close: no suggestion.
+    const auto far = caseErrorOf([] { parse("qqqqqqqqqq = 1\n"); });
+    EXPECT_EQ(far.exitCode, exit_code::unknown_key);
+    expectMessage(far, {"case.toml", "'qqqqqqqqqq'", "'enamel-dem keys'"});
+    EXPECT_EQ(std::string(far.what()).find("did you mean"), std::string::npos) << far.what();
+    // A one-letter key is not "close" to a two-letter one; a fragment of a key name is.
+    const auto oneLetter = caseErrorOf([] { parse("d = 1\n"); });
+    EXPECT_EQ(std::string(oneLetter.what()).find("did you mean"), std::string::npos) << oneLetter.what();
+    const auto fragment = caseErrorOf([] { parse("w_s = 10\n"); });
+    expectMessage(fragment, {"'w_s'", "did you mean 'w_s_over_d'?"});
+    const auto wrongCase = caseErrorOf([] { parse("CV = 0.1\n"); });
+    expectMessage(wrongCase, {"'CV'", "did you mean 'cv'?"});
+}
+
+TEST(CaseParams, WrongTypeNamesKeyValueAndExpectedRange) {
+    const auto e = caseErrorOf([] {
+        parseCase("theta_D = \"thirty\"\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", "case.toml", "", {});
+    });
+    EXPECT_EQ(e.exitCode, exit_code::wrong_type);
+    EXPECT_STREQ(e.what(),
+                 "case.toml: key 'theta_D' = \"thirty\" has the wrong type; expected a real number in [0, 45] (deg)");
+    const auto integer = caseErrorOf([] { parse("seed = 1.5\n"); });
+    EXPECT_EQ(integer.exitCode, exit_code::wrong_type);
+    expectMessage(integer, {"'seed'", "1.5", "integer", "[0, 2147483647]"});
+    const auto boolean = caseErrorOf([] { parse("rods_breakable = 1\n"); });
+    EXPECT_EQ(boolean.exitCode, exit_code::wrong_type);
+    expectMessage(boolean, {"'rods_breakable'", "= 1", "true or false"});
+    const auto list = caseErrorOf([] { parse("frames_da_over_d = 5\n"); });
+    EXPECT_EQ(list.exitCode, exit_code::wrong_type);
+    expectMessage(list, {"'frames_da_over_d'", "= 5", "list", "[0, 1e4]"});
+}
+
+TEST(CaseParams, OutOfRangeNamesKeyValueAndRange) {
+    const auto e = caseErrorOf([] {
+        parseCase("theta_D = 60\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", "case.toml", "", {});
+    });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    EXPECT_STREQ(e.what(), "case.toml: key 'theta_D' = 60 is out of range; allowed [0, 45] (deg)");
+    // An open bound is excluded and shown as such.
+    const auto open = caseErrorOf([] {
+        parseCase("theta_D = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 0\n", "case.toml", "", {});
+    });
+    EXPECT_EQ(open.exitCode, exit_code::out_of_range);
+    expectMessage(open, {"'sigma_ru_over_sigma0'", "= 0", "(0, 1e6]"});
+    const auto choice = caseErrorOf([] { parse("integrator = \"fast\"\n"); });
+    EXPECT_EQ(choice.exitCode, exit_code::out_of_range);
+    expectMessage(choice, {"'integrator'", "\"fast\"", "\"paper\"", "\"lumped\""});
+    const auto integer = caseErrorOf([] { parse("seed = -1\n"); });
+    EXPECT_EQ(integer.exitCode, exit_code::out_of_range);
+    expectMessage(integer, {"'seed'", "-1", "[0, 2147483647]"});
+    const auto element = caseErrorOf([] { parse("frames_da_over_d = [5, -1]\n"); });
+    EXPECT_EQ(element.exitCode, exit_code::out_of_range);
+    expectMessage(element, {"'frames_da_over_d'", "[5, -1]", "each in [0, 1e4]"});
+}
+
+TEST(CaseParams, IntegerBoundsAreExact) {
+    EXPECT_EQ(parse("max_steps = 4611686018427387904\n").max_steps, 4611686018427387904LL);  // 2^62 allowed
+    const auto e = caseErrorOf([] { parse("max_steps = 4611686018427387905\n"); });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    expectMessage(e, {"'max_steps'", "4611686018427387905", "[0, 4611686018427387904]"});
+}
+
+TEST(CaseParams, NonFiniteValueIsOutOfRange) {
+    for (const std::string value : {"nan", "inf", "-inf"}) {
+        const auto e = caseErrorOf([&] { parse("v_app_over_cd = " + value + "\n"); });
+        EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+        expectMessage(e, {"'v_app_over_cd'", "= " + value, "is not finite", "(0, 0.1]"});
+    }
+    const auto list = caseErrorOf([] { parse("frames_da_over_d = [1, nan]\n"); });
+    EXPECT_EQ(list.exitCode, exit_code::out_of_range);
+    expectMessage(list, {"'frames_da_over_d'", "is not finite"});
+}
+
+TEST(CaseParams, NegativeSizeIsOutOfRange) {
+    const auto e = caseErrorOf([] { parse("w_s_over_d = -5\n"); });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    EXPECT_STREQ(e.what(), "case.toml: key 'w_s_over_d' = -5 is out of range; allowed [2, 2000] (d)");
+}
+
+TEST(CaseParams, SliceSpacingLargerThanDIsAnError) {
+    const auto e = caseErrorOf([] { parse("h_e_over_d = 1.5\n"); });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    expectMessage(e, {"case.toml", "'h_e_over_d'", "= 1.5", "h_e larger than d", "(0, 1]"});
+    EXPECT_EQ(parse("h_e_over_d = 1\n").h_e_over_d, 1.0);  // h_e = d itself is allowed
+}
+
+TEST(CaseParams, MissingRequiredKey) {
+    const auto e = caseErrorOf([] { parseCase("Er_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", "case.toml", "", {}); });
+    EXPECT_EQ(e.exitCode, exit_code::unknown_key);
+    EXPECT_STREQ(e.what(), "case.toml: missing required key 'theta_D' (decussation angle, deg; allowed [0, 45])");
+    // A --set override can supply it.
+    const CaseParams p = parseCase("Er_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", "case.toml", "", {"theta_D=15"});
+    EXPECT_EQ(p.theta_D, 15.0);
+}
+
+TEST(CaseParams, MissingFile) {
+    const std::string path = ::testing::TempDir() + "no_such_dir/x.toml";
+    const auto e = caseErrorOf([&] { enamel::loadCase(path, "", {}); });
+    EXPECT_EQ(e.exitCode, exit_code::missing_file);
+    EXPECT_EQ(std::string(e.what()), "cannot open case file '" + path + "': No such file or directory");
+    // A directory opens but cannot be read.
+    const auto dir = caseErrorOf([] { enamel::loadCase(::testing::TempDir(), "", {}); });
+    EXPECT_EQ(dir.exitCode, exit_code::missing_file);
+    expectMessage(dir, {"case file", ::testing::TempDir()});
+}
+
+TEST(CaseParams, MalformedToml) {
+    const auto e = caseErrorOf([] { parseCase("theta_D = 30\nEr_over_kd = = 10\n", "case.toml", "", {}); });
+    EXPECT_EQ(e.exitCode, exit_code::malformed_toml);
+    expectMessage(e, {"case.toml:2:", ": malformed TOML: "});
+    const auto duplicate = caseErrorOf([] { parse("theta_D = 15\n"); });
+    EXPECT_EQ(duplicate.exitCode, exit_code::malformed_toml);
+    expectMessage(duplicate, {"case.toml:4:", "malformed TOML", "theta_D"});
+}
+
+TEST(CaseParams, NestedTableIsAnError) {
+    const auto e = caseErrorOf([] { parseCase("[physics]\ntheta_D = 30\n", "case.toml", "", {}); });
+    EXPECT_EQ(e.exitCode, exit_code::unknown_key);
+    expectMessage(e, {"case.toml", "'physics'", "is a table"});
+    const auto dotted = caseErrorOf([] { parse("numerics.zeta = 0.1\n"); });
+    EXPECT_EQ(dotted.exitCode, exit_code::unknown_key);
+    expectMessage(dotted, {"'numerics'", "is a table"});
+    const auto known = caseErrorOf([] { parse("zeta = { a = 1 }\n"); });
+    EXPECT_EQ(known.exitCode, exit_code::wrong_type);
+    expectMessage(known, {"'zeta'", "a = 1", "[0, 1]"});
+}
+
+TEST(CaseParams, BadSetOverride) {
+    const auto noEquals = caseErrorOf([] { parse("", "", {"theta_D"}); });
+    EXPECT_EQ(noEquals.exitCode, exit_code::usage);
+    expectMessage(noEquals, {"--set", "'theta_D'", "key=value"});
+    const auto noKey = caseErrorOf([] { parse("", "", {"=3"}); });
+    EXPECT_EQ(noKey.exitCode, exit_code::usage);
+    const auto unknown = caseErrorOf([] { parse("", "", {"theta=15"}); });
+    EXPECT_EQ(unknown.exitCode, exit_code::unknown_key);
+    expectMessage(unknown, {"--set theta=15", "'theta'", "did you mean 'theta_D'"});
+    const auto range = caseErrorOf([] { parse("", "", {"theta_D=99"}); });
+    EXPECT_EQ(range.exitCode, exit_code::out_of_range);
+    EXPECT_STREQ(range.what(), "--set theta_D=99: key 'theta_D' = 99 is out of range; allowed [0, 45] (deg)");
+    const auto type = caseErrorOf([] { parse("", "", {"theta_D=thirty"}); });
+    EXPECT_EQ(type.exitCode, exit_code::wrong_type);
+    expectMessage(type, {"'theta_D'", "\"thirty\"", "[0, 45]"});
+}
+
+TEST(CaseParams, UnknownPreset) {
+    const auto e = caseErrorOf([] { parse("", "fast"); });
+    EXPECT_EQ(e.exitCode, exit_code::usage);
+    EXPECT_STREQ(e.what(), "unknown preset 'fast'; allowed presets: ci, reduced, paper");
+}
+
+TEST(CaseParams, LayeringDefaultsPresetFileSet) {
+    // defaults
+    EXPECT_EQ(parse("").w_s_over_d, 32.0);
+    // preset > defaults
+    const CaseParams preset = parse("", "reduced");
+    EXPECT_EQ(preset.presetName, "reduced");
+    EXPECT_EQ(preset.w_s_over_d, 80.0);
+    EXPECT_EQ(preset.h_s_over_d, 40.0);
+    EXPECT_EQ(preset.frames_da_over_d, (std::vector<double>{5, 10, 20}));
+    EXPECT_EQ(preset.zeta, 0.2);  // not in the preset: default
+    // case file > preset
+    const CaseParams file = parse("w_s_over_d = 50\n", "reduced");
+    EXPECT_EQ(file.w_s_over_d, 50.0);
+    EXPECT_EQ(file.h_s_over_d, 40.0);
+    // --set > case file, later --set > earlier
+    const CaseParams set = parse("w_s_over_d = 50\n", "reduced", {"w_s_over_d=60", "w_s_over_d = 70"});
+    EXPECT_EQ(set.w_s_over_d, 70.0);
+    EXPECT_EQ(set.h_s_over_d, 40.0);
+}
+
+TEST(CaseParams, SetValuesAreTomlValues) {
+    const CaseParams p = parse("", "", {"theta_D=15", "integrator=lumped", "linear_solver=\"umfpack\"",
+                                        "frames_da_over_d=[1,2.5]", "rods_breakable=false", "seed=7",
+                                        "description=a free text"});
+    EXPECT_EQ(p.theta_D, 15.0);
+    EXPECT_EQ(p.integrator, "lumped");  // not valid TOML: taken as a string
+    EXPECT_EQ(p.linear_solver, "umfpack");
+    EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{1, 2.5}));
+    EXPECT_FALSE(p.rods_breakable);
+    EXPECT_EQ(p.seed, 7);
+    EXPECT_EQ(p.description, "a free text");
+}
+
+TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
+    const auto names = enamel::presetNames();
+    ASSERT_EQ(names, (std::vector<std::string>{"ci", "reduced", "paper"}));
+    const CaseParams none = parse("");
+    for (const std::string& name : names) {
+        // A preset that set a physics key would throw std::logic_error here.
+        const CaseParams p = parse("", name);
+        EXPECT_EQ(p.presetName, name);
+        EXPECT_EQ(p.theta_D, none.theta_D);
+        EXPECT_EQ(p.cv, none.cv);
+        EXPECT_EQ(p.Gamma_k_over_sigma0sq, none.Gamma_k_over_sigma0sq);
+        EXPECT_EQ(p.seed, none.seed);
+    }
+    const CaseParams ci = parse("", "ci");
+    EXPECT_EQ(ci.v_app_over_cd, 2e-3);
+    EXPECT_EQ(ci.stop_da_over_d, 8.0);
+    EXPECT_EQ(ci.frames_da_over_d, (std::vector<double>{2, 4, 8}));
+    const CaseParams paper = parse("", "paper");
+    EXPECT_EQ(paper.w_s_over_d, 200.0);
+    EXPECT_EQ(paper.h_s_over_d, 200.0);
+}
+
+TEST(CaseParams, KeyTableIsComplete) {
+    const auto& keys = enamel::caseKeys();
+    ASSERT_GE(keys.size(), 30u);
+    std::set<std::string> names;
+    for (const KeySpec& s : keys) {
+        SCOPED_TRACE(s.name);
+        EXPECT_TRUE(names.insert(s.name).second) << "duplicate key";
+        const std::string group = s.group, doc = s.doc, unit = s.unit;
+        EXPECT_TRUE(group == "physics" || group == "numerics");
+        EXPECT_FALSE(unit.empty());
+        EXPECT_GT(doc.find(':'), 0u) << "doc needs 'short name: details'";
+        EXPECT_NE(doc.find(':'), std::string::npos) << "doc needs 'short name: details'";
+        if (s.required) {
+            EXPECT_EQ(group, "physics");
+            continue;
+        }
+        switch (s.kind) {
+            case Kind::Real:
+            case Kind::Integer: {
+                const double x = s.defaultValue;
+                EXPECT_TRUE(s.minOpen ? x > s.minValue : x >= s.minValue) << "default below range";
+                EXPECT_TRUE(s.maxOpen ? x < s.maxValue : x <= s.maxValue) << "default above range";
+                if (s.kind == Kind::Integer) {
+                    EXPECT_EQ(x, std::floor(x));
+                }
+                break;
+            }
+            case Kind::Choice: {
+                const std::string choices = std::string("|") + s.choices + "|";
+                EXPECT_NE(choices.find(std::string("|") + s.defaultText + "|"), std::string::npos);
+                break;
+            }
+            case Kind::RealList: EXPECT_EQ(s.defaultText[0], '['); break;
+            case Kind::Bool: EXPECT_TRUE(s.defaultValue == 0 || s.defaultValue == 1); break;
+            case Kind::Text: break;
+        }
+    }
+    // Every default together passes the parser's own checks (lists element by element).
+    EXPECT_NO_THROW(parse(""));
+}
+
+TEST(CaseParams, FormatKeysMarkdownListsEveryKey) {
+    const std::string md = enamel::formatKeysMarkdown();
+    std::size_t rows = 0;
+    for (char c : md) rows += c == '\n';
+    EXPECT_EQ(rows, enamel::caseKeys().size() + 2);  // header + separator + one row per key
+    for (const KeySpec& s : enamel::caseKeys())
+        EXPECT_NE(md.find("| `" + std::string(s.name) + "` | " + s.group + " | "), std::string::npos) << s.name;
+    EXPECT_NE(md.find("| `theta_D` | physics | required | [0, 45] | deg |"), std::string::npos) << md;
+    EXPECT_NE(md.find("\"paper\", \"lumped\""), std::string::npos);
+    EXPECT_NE(md.find("sigma0^2/k"), std::string::npos);
+}
+
+TEST(CaseParams, EffectiveTomlRoundTrips) {
+    const CaseParams p = parse("description = \"quote \\\" and\\nnewline\"\ncv = 0.1\n", "reduced",
+                               {"integrator=lumped", "frames_da_over_d=[1, 2.5]", "max_steps=12345"});
+    EXPECT_NE(p.tomlText.find("# preset: reduced"), std::string::npos);
+    EXPECT_NE(p.tomlText.find("# --set integrator=lumped"), std::string::npos);
+    const CaseParams q = parseCase(p.tomlText, "effective.toml", "", {});
+    EXPECT_EQ(keyLines(q.tomlText), keyLines(p.tomlText));
+    EXPECT_EQ(q.description, "quote \" and\nnewline");
+    EXPECT_EQ(q.cv, 0.1);
+    EXPECT_EQ(q.w_s_over_d, 80.0);
+    EXPECT_EQ(q.integrator, "lumped");
+    EXPECT_EQ(q.frames_da_over_d, (std::vector<double>{1, 2.5}));
+    EXPECT_EQ(q.max_steps, 12345);
+    EXPECT_EQ(q.sigma_ru_over_sigma0, 21.4);  // shortest round-trip formatting keeps every bit
+    EXPECT_EQ(q.delta0_over_d, 1e-3);
+}
+
+TEST(CaseParams, LoadCaseReadsFileAndRecordsSource) {
+    const std::string path = writeTempFile("case_params_load.toml", kPhysics + "cv = 0.2\n");
+    const CaseParams p = enamel::loadCase(path, "ci", {"seed=3"});
+    EXPECT_EQ(p.sourceName, path);
+    EXPECT_EQ(p.cv, 0.2);
+    EXPECT_EQ(p.seed, 3);
+    EXPECT_EQ(p.w_s_over_d, 32.0);
+    std::remove(path.c_str());
+}
+
+TEST(CaseParams, SmallTestCasesLoad) {
+    for (const double theta : {0.0, 30.0}) {
+        const std::string path = std::string(ENAMEL_SOURCE_DIR) + "/tests/cases/small_theta" +
+                                 std::to_string(static_cast<int>(theta)) + ".toml";
+        const CaseParams p = enamel::loadCase(path, "ci", {});  // case file sizes win over the preset
+        EXPECT_EQ(p.theta_D, theta);
+        EXPECT_EQ(p.Er_over_kd, 10.0);
+        EXPECT_EQ(p.sigma_ru_over_sigma0, 21.4);
+        EXPECT_EQ(p.w_s_over_d, 6.0);
+        EXPECT_EQ(p.h_s_over_d, 4.0);
+        EXPECT_EQ(p.h_e_over_d, 0.3);
+        EXPECT_LT(p.stop_da_over_d, p.w_s_over_d - p.a0());
+    }
+}

@@ -1,0 +1,326 @@
+// Tests of the symmetric trapezoidal cohesive law and the rigid-arm interface element (solver/lib/cohesive).
+#include "cohesive.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace enamel::cohesive;
+
+namespace {
+
+// Normalised defaults of DESIGN.md section 1: Er/(k d) = 10 -> k = 0.1; delta0/d = 1e-3 -> sigma0 = 1e-4;
+// Gamma k / sigma0^2 = 3 -> Gamma = 3e-7. So delta0 = 1e-3, delta1 = 3e-3, deltaf = 4e-3.
+const Law kLaw = makeLaw(0.1, 1e-4, 3e-7);
+
+// Round-off tolerance for closed-form quantities evaluated with a handful of flops.
+constexpr double kRoundoff = 1e-12;
+// Energy from trapezoid-rule integration of the work: exact on linear pieces, O(h^2) at kinks and on
+// curved pieces; the brief asks for 1e-6 relative.
+constexpr double kWorkTol = 1e-6;
+
+// Work int t . d(opening) along the straight leg from -> to in local opening space, trapezoid rule with n
+// steps, updating lambdaMax and the traction at the start of the leg (tPrev).
+double integrateWork(const Law& law, const Vec3& from, const Vec3& to, int n, double& lambdaMax, Vec3& tPrev) {
+  double work = 0.0;
+  Vec3 gPrev = from;
+  for (int i = 1; i <= n; ++i) {
+    const Vec3 g = from + (to - from) * (double(i) / n);
+    const Vec3 t = computeTraction(law, g, lambdaMax);
+    work += 0.5 * (tPrev + t).dot(g - gPrev);
+    tPrev = t;
+    gPrev = g;
+  }
+  return work;
+}
+
+// Monotonic radial opening lambda * e (e unit, e_n >= 0) from 0 to 1.2 deltaf; each leg of the path ends on a
+// kink of the envelope (delta0, delta1, deltaf), so the trapezoid rule is exact on every leg.
+double monotonicWork(const Law& law, const Vec3& e, double& lambdaMax) {
+  const std::vector<double> breaks = {0.0, law.delta0(), law.delta1(), law.deltaf(), 1.2 * law.deltaf()};
+  Vec3 tPrev = computeTraction(law, Vec3::Zero(), lambdaMax);
+  double work = 0.0;
+  for (size_t b = 1; b < breaks.size(); ++b)
+    work += integrateWork(law, breaks[b - 1] * e, breaks[b] * e, 1000, lambdaMax, tPrev);
+  return work;
+}
+
+Vec3 randomVec(std::mt19937& rng, double scale) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return scale * Vec3(u(rng), u(rng), u(rng));
+}
+
+// Interface between random rod centres xA, xB with a common Voronoi-edge midpoint m near their midpoint.
+InterfaceGeometry randomGeometry(std::mt19937& rng, Vec3& xA, Vec3& xB) {
+  xA = randomVec(rng, 2.0);
+  xB = xA + randomVec(rng, 1.0);
+  const Vec3 m = 0.5 * (xA + xB) + randomVec(rng, 0.2);
+  return InterfaceGeometry{makeFrame(xB - xA), m - xA, m - xB, 0.3 * 0.577};
+}
+
+}  // namespace
+
+TEST(Cohesive, EnvelopeShapeAndArea) {
+  const Law& L = kLaw;
+  EXPECT_NEAR(L.delta0(), 1e-3, kRoundoff * 1e-3);
+  EXPECT_NEAR(L.delta1(), 3e-3, kRoundoff * 3e-3);
+  EXPECT_NEAR(L.deltaf(), 4e-3, kRoundoff * 4e-3);
+  EXPECT_DOUBLE_EQ(envelopeTraction(L, 0.0), 0.0);
+  EXPECT_NEAR(envelopeTraction(L, 0.5 * L.delta0()), 0.5 * L.sigma0, kRoundoff * L.sigma0);
+  EXPECT_NEAR(envelopeTraction(L, L.delta0()), L.sigma0, kRoundoff * L.sigma0);
+  EXPECT_DOUBLE_EQ(envelopeTraction(L, 0.5 * (L.delta0() + L.delta1())), L.sigma0);
+  EXPECT_DOUBLE_EQ(envelopeTraction(L, L.delta1()), L.sigma0);
+  EXPECT_NEAR(envelopeTraction(L, L.delta1() + 0.25 * L.delta0()), 0.75 * L.sigma0, kRoundoff * L.sigma0);
+  EXPECT_DOUBLE_EQ(envelopeTraction(L, L.deltaf()), 0.0);
+  EXPECT_DOUBLE_EQ(envelopeTraction(L, 2.0 * L.deltaf()), 0.0);
+  // Continuity just past each kink (jump at most slope * eps; eps = 1e-9 deltaf).
+  const double eps = 1e-9 * L.deltaf();
+  for (double kink : {L.delta0(), L.delta1(), L.deltaf()})
+    EXPECT_NEAR(envelopeTraction(L, kink + eps), envelopeTraction(L, kink), 2.0 * L.k * eps) << kink;
+  // Area = Gamma: exact piecewise trapezoid areas.
+  const double area = 0.5 * L.sigma0 * L.delta0() + L.sigma0 * (L.delta1() - L.delta0()) +
+                      0.5 * L.sigma0 * (L.deltaf() - L.delta1());
+  EXPECT_NEAR(area, L.Gamma, kRoundoff * L.Gamma);
+}
+
+TEST(Cohesive, EffectiveSeparationIgnoresCompression) {
+  EXPECT_DOUBLE_EQ(effectiveSeparation(Vec3(3.0, 4.0, 0.0)), 5.0);
+  EXPECT_DOUBLE_EQ(effectiveSeparation(Vec3(-7.0, 3.0, 4.0)), 5.0);
+  EXPECT_DOUBLE_EQ(effectiveSeparation(Vec3(-7.0, 0.0, 0.0)), 0.0);
+}
+
+TEST(Cohesive, MonotonicOpeningDissipatesGammaInEveryMode) {
+  const std::vector<std::pair<const char*, Vec3>> dirs = {
+      {"normal", Vec3(1, 0, 0)}, {"shear t1", Vec3(0, 1, 0)}, {"shear t2", Vec3(0, 0, 1)},
+      {"mixed", Vec3(0.6, -0.48, 0.64).normalized()}};
+  for (const auto& [name, e] : dirs) {
+    double lambdaMax = 0.0;
+    const double work = monotonicWork(kLaw, e, lambdaMax);
+    EXPECT_NEAR(work, kLaw.Gamma, kWorkTol * kLaw.Gamma) << name;
+    EXPECT_TRUE(isFailed(kLaw, lambdaMax)) << name;
+    EXPECT_DOUBLE_EQ(damage(kLaw, lambdaMax), 1.0) << name;
+    // After failure nothing is stored, all the work is dissipated: exactly Gamma (1e-12 relative).
+    EXPECT_NEAR(storedEnergyDensity(kLaw, 1.2 * kLaw.deltaf() * e, lambdaMax), 0.0, 1e-12 * kLaw.Gamma) << name;
+    EXPECT_NEAR(dissipatedEnergyDensity(kLaw, lambdaMax), kLaw.Gamma, 1e-12 * kLaw.Gamma) << name;
+    EXPECT_NEAR(dissipatedEnergyDensity(kLaw, kLaw.deltaf()), kLaw.Gamma, 1e-12 * kLaw.Gamma) << name;
+  }
+}
+
+TEST(Cohesive, TriangleLawAllowedAndDissipatesGamma) {
+  // Gamma = sigma0^2/k: delta1 = delta0, no plateau.
+  const Law tri = makeLaw(0.1, 1e-4, 1e-4 * 1e-4 / 0.1);
+  EXPECT_NEAR(tri.delta1(), tri.delta0(), kRoundoff * tri.delta0());
+  double lambdaMax = 0.0;
+  EXPECT_NEAR(monotonicWork(tri, Vec3(0, 1, 0), lambdaMax), tri.Gamma, kWorkTol * tri.Gamma);
+  EXPECT_NEAR(dissipatedEnergyDensity(tri, lambdaMax), tri.Gamma, 1e-12 * tri.Gamma);
+}
+
+TEST(Cohesive, DissipatedEnergyIsContinuousAndMonotonic) {
+  // Continuity at each kink within slope * eps; the steepest slope, on the softening branch, is
+  // d/dlambda (Gamma - 0.5 T deltaf) = 0.5 sigma0 deltaf / delta0 (plus 1% for round-off).
+  const double eps = 1e-9 * kLaw.deltaf();
+  const double maxSlope = 0.5 * kLaw.sigma0 * kLaw.deltaf() / kLaw.delta0();
+  for (double kink : {kLaw.delta0(), kLaw.delta1(), kLaw.deltaf()})
+    EXPECT_NEAR(dissipatedEnergyDensity(kLaw, kink - eps), dissipatedEnergyDensity(kLaw, kink), 1.01 * maxSlope * eps);
+  EXPECT_DOUBLE_EQ(dissipatedEnergyDensity(kLaw, 0.7 * kLaw.delta0()), 0.0);
+  double prev = 0.0;
+  for (int i = 0; i <= 200; ++i) {
+    const double w = dissipatedEnergyDensity(kLaw, 1.2 * kLaw.deltaf() * i / 200.0);
+    EXPECT_GE(w, prev) << i;
+    prev = w;
+  }
+}
+
+TEST(Cohesive, SecantUnloadingAndReloadingWithoutExtraDamage) {
+  const Vec3 e = Vec3(0.5, 0.7, -0.3).normalized();
+  for (double lambdaU : {0.5 * (kLaw.delta0() + kLaw.delta1()), 0.5 * (kLaw.delta1() + kLaw.deltaf())}) {
+    double lambdaMax = 0.0;
+    computeTraction(kLaw, lambdaU * e, lambdaMax);
+    ASSERT_DOUBLE_EQ(lambdaMax, lambdaU);
+    const double S = envelopeTraction(kLaw, lambdaU) / lambdaU;
+    const double damageU = damage(kLaw, lambdaMax);
+    EXPECT_NEAR(damageU, 1.0 - S / kLaw.k, kRoundoff);
+    // Unload to the origin, then reload to the same point: t = S * opening throughout (1e-12 of sigma0).
+    for (int i = 0; i <= 40; ++i) {
+      const double s = (i <= 20) ? 1.0 - i / 20.0 : (i - 20) / 20.0;
+      const Vec3 g = s * lambdaU * e;
+      const Vec3 t = computeTraction(kLaw, g, lambdaMax);
+      EXPECT_LE((t - S * g).norm(), kRoundoff * kLaw.sigma0) << "s = " << s;
+      EXPECT_DOUBLE_EQ(lambdaMax, lambdaU) << "no extra damage, s = " << s;
+      if (i == 20) {
+        EXPECT_EQ(t.norm(), 0.0) << "zero traction at zero opening";
+      }
+    }
+    EXPECT_DOUBLE_EQ(damage(kLaw, lambdaMax), damageU);
+    // Back on the envelope at the reload point, and following it beyond.
+    Vec3 t = computeTraction(kLaw, lambdaU * e, lambdaMax);
+    EXPECT_NEAR(t.norm(), envelopeTraction(kLaw, lambdaU), kRoundoff * kLaw.sigma0);
+    t = computeTraction(kLaw, 1.05 * lambdaU * e, lambdaMax);
+    EXPECT_DOUBLE_EQ(lambdaMax, 1.05 * lambdaU);
+    EXPECT_NEAR(t.norm(), envelopeTraction(kLaw, 1.05 * lambdaU), kRoundoff * kLaw.sigma0);
+  }
+}
+
+TEST(Cohesive, CompressionNeverDamages) {
+  double lambdaMax = 0.0;
+  const double dn = -100.0 * kLaw.deltaf();
+  const Vec3 t = computeTraction(kLaw, Vec3(dn, 0.0, 0.0), lambdaMax);
+  EXPECT_EQ(lambdaMax, 0.0);
+  EXPECT_DOUBLE_EQ(t(0), kLaw.k * dn);
+  EXPECT_EQ(t(1), 0.0);
+  EXPECT_EQ(t(2), 0.0);
+  EXPECT_FALSE(isInelastic(kLaw, lambdaMax));
+  EXPECT_EQ(damage(kLaw, lambdaMax), 0.0);
+  EXPECT_DOUBLE_EQ(storedEnergyDensity(kLaw, Vec3(dn, 0.0, 0.0), lambdaMax), 0.5 * kLaw.k * dn * dn);
+}
+
+TEST(Cohesive, ContactActsAfterFailure) {
+  double lambdaMax = 1.5 * kLaw.deltaf();
+  ASSERT_TRUE(isFailed(kLaw, lambdaMax));
+  const Vec3 g(-2.0 * kLaw.delta0(), 3.0 * kLaw.delta0(), -kLaw.delta0());
+  Vec3 t = computeTraction(kLaw, g, lambdaMax);
+  EXPECT_DOUBLE_EQ(t(0), kLaw.k * g(0));
+  EXPECT_EQ(t(1), 0.0) << "no shear transmitted once failed";
+  EXPECT_EQ(t(2), 0.0);
+  EXPECT_DOUBLE_EQ(lambdaMax, 1.5 * kLaw.deltaf());
+  t = computeTraction(kLaw, Vec3(0.5 * kLaw.delta0(), 0.1 * kLaw.delta0(), 0.0), lambdaMax);
+  EXPECT_EQ(t.norm(), 0.0) << "no traction in tension once failed";
+}
+
+TEST(Cohesive, WorkEqualsStoredPlusDissipatedAlongLoadingUnloadingPath) {
+  // Non-proportional path in local opening space (units of delta0 = 1e-3): elastic, softening, unloading into
+  // compression with shear, reloading past the old lambdaMax in another direction, partial unloading,
+  // failure, then contact after failure.
+  const double d = kLaw.delta0();
+  const std::vector<Vec3> path = {Vec3::Zero(),
+                                  0.4 * d * Vec3(1.0, 0.5, 0.0),
+                                  3.5 * d * Vec3(1.0, 1.0, 0.5).normalized(),
+                                  d * Vec3(-0.5, 0.2, -0.1),
+                                  d * Vec3(0.3, -3.7, 0.5),
+                                  d * Vec3(0.2, -1.0, 0.0),
+                                  d * Vec3(2.0, 5.0, -1.0),
+                                  d * Vec3(-1.0, 0.5, 0.2)};
+  double lambdaMax = 0.0, work = 0.0;
+  Vec3 tPrev = computeTraction(kLaw, path[0], lambdaMax);
+  for (size_t leg = 1; leg < path.size(); ++leg) {
+    work += integrateWork(kLaw, path[leg - 1], path[leg], 20000, lambdaMax, tPrev);
+    const double stored = storedEnergyDensity(kLaw, path[leg], lambdaMax);
+    const double dissipated = dissipatedEnergyDensity(kLaw, lambdaMax);
+    EXPECT_NEAR(work, stored + dissipated, kWorkTol * work) << "after leg " << leg;
+  }
+  EXPECT_TRUE(isFailed(kLaw, lambdaMax));
+  const double dn = path.back()(0);
+  EXPECT_NEAR(work, kLaw.Gamma + 0.5 * kLaw.k * dn * dn, kWorkTol * work);
+}
+
+TEST(Cohesive, FrameIsRightHandedOrthonormal) {
+  for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0, 0.3, -2.0), Vec3(1, 0, 0), Vec3(0.2, -0.5, 0.7)}) {
+    const Mat3 R = makeFrame(n);
+    EXPECT_LE((R * R.transpose() - Mat3::Identity()).norm(), kRoundoff);
+    EXPECT_NEAR(R.determinant(), 1.0, kRoundoff);
+    EXPECT_LE((R.row(0).transpose() - n.normalized()).norm(), kRoundoff);
+  }
+}
+
+TEST(Cohesive, NormalOpeningPullsNodesTogether) {
+  std::mt19937 rng(7);
+  Vec3 xA, xB;
+  const InterfaceGeometry g = randomGeometry(rng, xA, xB);
+  const Vec3 n = g.frame.row(0).transpose();
+  double lambdaMax = 0.0;
+  const Vec3 zero = Vec3::Zero();
+  const double dn = 0.5 * kLaw.delta0();
+  const NodalWrench w = computeInterfaceForces(kLaw, g, zero, zero, dn * n, zero, lambdaMax);
+  // Elastic: |F| = k * dn * area along -n on B (1e-12 relative).
+  EXPECT_LE((w.forceB + kLaw.k * dn * g.area * n).norm(), kRoundoff * kLaw.k * dn * g.area);
+  EXPECT_DOUBLE_EQ(lambdaMax, dn);
+}
+
+TEST(Cohesive, RigidRotationOpensNothing) {
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 50; ++trial) {
+    Vec3 xA, xB;
+    const InterfaceGeometry g = randomGeometry(rng, xA, xB);
+    const Vec3 p = randomVec(rng, 1.0), w = randomVec(rng, 1.0), c = randomVec(rng, 1.0);
+    // Rigid motion u = c + w x (x - p), th = w at both nodes.
+    const Vec3 uA = c + w.cross(xA - p), uB = c + w.cross(xB - p);
+    const Vec3 opening = computeOpening(g, uA, w, uB, w);
+    EXPECT_LE(opening.cwiseAbs().maxCoeff(), 1e-14) << "trial " << trial;  // round-off of O(1) values
+    double lambdaMax = 0.0;
+    const NodalWrench f = computeInterfaceForces(kLaw, g, uA, w, uB, w, lambdaMax);
+    // Force from a round-off opening: at most k * area * 1e-14.
+    const double fTol = kLaw.k * g.area * 1e-14;
+    EXPECT_LE(f.forceA.norm(), fTol);
+    EXPECT_LE(f.forceB.norm(), fTol);
+    EXPECT_LE(f.momentA.norm(), 4.0 * fTol);  // arms are shorter than 2
+    EXPECT_LE(f.momentB.norm(), 4.0 * fTol);
+    // The linearised stiffness has the rigid motion in its null space (1e-12 of k * area * |q|).
+    Eigen::Matrix<double, 12, 1> q;
+    q << uA, w, uB, w;
+    EXPECT_LE((elasticStiffness(kLaw, g) * q).norm(), kRoundoff * kLaw.k * g.area * q.norm());
+  }
+}
+
+TEST(Cohesive, ForcesBalanceAndConserveAngularMomentum) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    Vec3 xA, xB;
+    const InterfaceGeometry g = randomGeometry(rng, xA, xB);
+    // Displacements from elastic to failed; rotations scaled so that theta x arm is comparable.
+    const double s = 1.5 * kLaw.deltaf();
+    const Vec3 uA = randomVec(rng, s), thA = randomVec(rng, s), uB = randomVec(rng, s), thB = randomVec(rng, s);
+    double lambdaMax = u01(rng) * kLaw.deltaf();
+    const NodalWrench f = computeInterfaceForces(kLaw, g, uA, thA, uB, thB, lambdaMax);
+    EXPECT_EQ((f.forceA + f.forceB).norm(), 0.0) << "equal and opposite by construction";
+    const Vec3 L = xA.cross(f.forceA) + f.momentA + xB.cross(f.forceB) + f.momentB;
+    const double scale = (xA.norm() + xB.norm() + g.armA.norm() + g.armB.norm()) * f.forceA.norm();
+    EXPECT_LE(L.norm(), kRoundoff * scale) << "trial " << trial;  // 1e-12 relative
+  }
+}
+
+TEST(Cohesive, ElasticStiffnessMatchesForcesInElasticRange) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 200; ++trial) {
+    Vec3 xA, xB;
+    const InterfaceGeometry g = randomGeometry(rng, xA, xB);
+    // |opening| <= s*sqrt(3)*(2 + 2*max|arm|) < 0.8 delta0, since |arm| <= sqrt(3)/2 + 0.2*sqrt(3) < 1.22.
+    const double s = 0.1 * kLaw.delta0();
+    const Vec3 uA = randomVec(rng, s), thA = randomVec(rng, s), uB = randomVec(rng, s), thB = randomVec(rng, s);
+    double lambdaMax = 0.0;
+    const NodalWrench f = computeInterfaceForces(kLaw, g, uA, thA, uB, thB, lambdaMax);
+    ASSERT_LE(lambdaMax, kLaw.delta0()) << "test meant for the elastic range";
+    Eigen::Matrix<double, 12, 1> q, fv;
+    q << uA, thA, uB, thB;
+    fv << f.forceA, f.momentA, f.forceB, f.momentB;
+    const Eigen::Matrix<double, 12, 12> K = elasticStiffness(kLaw, g);
+    EXPECT_LE((K * q + fv).norm(), 1e-10 * fv.norm()) << "trial " << trial;
+    EXPECT_LE((K - K.transpose()).norm(), kRoundoff * K.norm());
+  }
+}
+
+TEST(Cohesive, MakeLawRejectsBadParameters) {
+  EXPECT_THROW(makeLaw(0.1, 1e-4, 0.99e-7), std::invalid_argument);  // Gamma < sigma0^2/k = 1e-7
+  EXPECT_THROW(makeLaw(0.0, 1e-4, 3e-7), std::invalid_argument);
+  EXPECT_THROW(makeLaw(0.1, -1e-4, 3e-7), std::invalid_argument);
+  EXPECT_THROW(makeLaw(0.1, 1e-4, 0.0), std::invalid_argument);
+  EXPECT_THROW(makeLaw(std::numeric_limits<double>::quiet_NaN(), 1e-4, 3e-7), std::invalid_argument);
+  try {
+    makeLaw(0.1, 1e-4, 0.5e-7);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("Gamma"), std::string::npos) << ex.what();
+  }
+  try {
+    makeLaw(0.1, 0.0, 3e-7);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("sigma0"), std::string::npos) << ex.what();
+  }
+  EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7));
+}
