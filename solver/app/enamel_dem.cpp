@@ -65,7 +65,7 @@ int runInfo(const CaseArgs& args) {
   std::printf("element frequency  omega_max %.4g c_r/d: %s governs (bending %.4g, axial %.4g)\n",
               sim.omegaMaxElement, wBend > wAxial ? "bending" : "axial", wBend, wAxial);
   std::printf("time step          dt %.4g d/c_r (integrator %s)\n", sim.integrator->timeStep(),
-              sim.integrator->name().c_str());
+              sim.integrator->describe().c_str());
   std::printf("transverse modulus E_transverse %.4g E_r, c_d %.4g c_r%s\n", sim.E_transverse, sim.c_d,
               p.E_transverse_over_Er > 0 ? " (given)" : " (measured)");
   std::printf("damping            zeta %g at w_min %.4g: a %.4g, b %.4g\n", p.zeta, sim.omegaMin, sim.dampA, sim.dampB);

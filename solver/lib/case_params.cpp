@@ -42,9 +42,10 @@ const std::vector<KeySpec>& caseKeys() {
         {"Gamma_k_over_sigma0sq", Kind::Real, "physics", false, 3, 1, 1e4, C, C, "", "", "sigma0^2/k",
          "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "
          "fracture length)"},
-        {"delta0_over_d", Kind::Real, "physics", false, 1e-3, 0, 1, O, C, "", "", "d",
-         "interface elastic separation: delta0 = sigma0 / k (scales all forces; irrelevant to "
-         "normalised results in linear kinematics)"},
+        {"delta0_over_d", Kind::Real, "physics", false, 0.1, 0, 1, O, C, "", "", "d",
+         "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "
+         "displacements, so results depend on it only through the loading rate: what is quasi-static is "
+         "(v_app/c_d) (h_s / U_c) << 1 with the initiation displacement U_c proportional to delta0 (README, Model)"},
         {"nu_r", Kind::Real, "physics", false, 0.3, 0, 0.5, C, O, "", "", "-",
          "rod Poisson ratio: sets the torsional stiffness G J"},
         {"section", Kind::Choice, "physics", false, 0, 0, 0, C, C, "hexagon|circle", "hexagon", "-",
@@ -112,7 +113,7 @@ const std::vector<KeySpec>& caseKeys() {
 
 // ---------------------------------------------------------------------------------------------
 // Presets: numerics only (specimen size, mesh, loading rate, stop criterion, frames).
-// PLACEHOLDER VALUES, to be tuned by the lead: this is the one table to edit.
+// This is the one table to edit; the README section "Presets" states what each sets and why.
 // ---------------------------------------------------------------------------------------------
 namespace {
 struct Preset {
@@ -120,14 +121,15 @@ struct Preset {
     const char* toml;
 };
 const Preset kPresets[] = {
+    // ci: seconds to a minute per case with the lumped scheme; (v_app/c_d) h_s / U_c ~ 0.025
     {"ci",
-     "w_s_over_d = 32\nh_s_over_d = 16\nh_e_over_d = 0.3\nv_app_over_cd = 2e-3\n"
-     "stop_da_over_d = 8\nframes_da_over_d = [2, 4, 8]\n"},
+     "w_s_over_d = 16\nh_s_over_d = 8\nh_e_over_d = 0.3\nv_app_over_cd = 2e-3\nintegrator = \"lumped\"\n"
+     "stop_da_over_d = 5\nframes_da_over_d = [1, 2.5, 5]\n"},
     {"reduced",
-     "w_s_over_d = 80\nh_s_over_d = 40\nh_e_over_d = 0.3\nv_app_over_cd = 1e-3\n"
-     "stop_da_over_d = 20\nframes_da_over_d = [5, 10, 20]\n"},
+     "w_s_over_d = 40\nh_s_over_d = 20\nh_e_over_d = 0.3\nv_app_over_cd = 2.5e-3\nintegrator = \"lumped\"\n"
+     "stop_da_over_d = 12\nframes_da_over_d = [3, 6, 12]\n"},
     {"paper",
-     "w_s_over_d = 200\nh_s_over_d = 200\nh_e_over_d = 0.3\nv_app_over_cd = 1e-3\n"
+     "w_s_over_d = 200\nh_s_over_d = 200\nh_e_over_d = 0.3\nv_app_over_cd = 1e-3\nintegrator = \"paper\"\n"
      "stop_da_over_d = 30\nframes_da_over_d = [5, 15, 30]\n"},
 };
 }  // namespace

@@ -1,6 +1,7 @@
 #include "integrators.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include <Eigen/CholmodSupport>
@@ -137,12 +138,153 @@ class PaperIntegrator : public Integrator {
   VecX w_, fI_, Kq_, Kw_, Mw_, r_, rf_, af_;
 };
 
+
+// Rotary-inertia scale for the lumped element (DESIGN section 4): with physical rotary inertia the short
+// beam's rotation modes govern; scaling the rotary inertia up lowers them until the element's highest
+// frequency is set by its translational masses (axial 2c/L, or the bending mode with rotations frozen,
+// sqrt(48 E I / (rho A L^4))), which no rotary scaling can lower. Returns the smallest scale >= 1 within 5% of
+// that floor. Rotary inertia does not enter a quasi-static solution; the added inertia is reported.
+double rotaryScaleForTranslationalLimit(const beam::Section& s, double L) {
+  const double floor = beam::maxFrequency(s, L, beam::MassKind::Lumped, 1e8);
+  auto governs = [&](double scale) { return beam::maxFrequency(s, L, beam::MassKind::Lumped, scale) > 1.05 * floor; };
+  double lo = 1.0, hi = 1.0;
+  if (!governs(lo)) return lo;
+  while (governs(hi)) hi *= 2.0;
+  for (int it = 0; it < 40; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (governs(mid) ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// Largest frequency of the assembled undamped system M^-1 (K + K_iface) with a diagonal mass, by power
+// iteration (prescribed DOFs held). Interfaces enter through their elastic force at a small amplitude (the
+// law is linear below delta0, contact included), never assembled.
+double estimateOmegaMax(Simulation& sim, const VecX& invMass) {
+  const int n = static_cast<int>(invMass.size());
+  VecX x = VecX::Zero(n), f(n), y(n);
+  std::uint64_t seed = 12345;  // fixed start vector: the estimate is deterministic
+  for (int dof : sim.freeDofs) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    x[dof] = static_cast<double>(seed >> 11) / 9007199254740992.0 - 0.5;
+  }
+  const double amplitude = 1e-3 * sim.law.delta0();
+  double lambda = 0;
+  for (int it = 0; it < 300; ++it) {
+    x *= amplitude / x.cwiseAbs().maxCoeff();
+    sim.computeForcesForInterfaces(x, f, false);
+    y = invMass.cwiseProduct(sim.K * x + f);
+    for (int dof : sim.prescribedDofs) y[dof] = 0;
+    const double next = x.dot(y.cwiseQuotient(invMass)) / x.dot(x.cwiseQuotient(invMass));
+    x = y;
+    if (it > 20 && std::abs(next - lambda) < 1e-6 * next) { lambda = next; break; }
+    lambda = next;
+  }
+  return std::sqrt(std::max(lambda, 0.0));
+}
+
+// Fast scheme `lumped` (ours, DESIGN section 4): explicit central differences with a diagonal mass.
+//   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
+//      alpha rho Ip L / 2 per element end, alpha the smallest scale at which rotations stop governing.
+//   C = a M + b' K with b' = min(b, 1/omega_max) (the stiffness part capped so that its damping ratio at
+//      omega_max is at most 1/2; an explicit stiffness damping above that would need a far smaller step).
+//   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface(q_n) - b' K v_{n-1/2})] / (1 + a dt/2)
+//   q_{n+1}   = q_n + dt v_{n+1/2}
+//   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
+//   2 / omega_max (sqrt(1 + xi^2) - xi), xi = b' omega_max / 2.
+class LumpedIntegrator : public Integrator {
+ public:
+  explicit LumpedIntegrator(Simulation& sim) {
+    const Model& m = sim.model;
+    const double L = m.beamLength;
+    rotaryScale_ = rotaryScaleForTranslationalLimit(sim.section, L);
+    const double mt = 0.5 * sim.section.rho * sim.section.A * L;
+    const double jr = rotaryScale_ * 0.5 * sim.section.rho * sim.section.Ip * L;
+    mass_ = VecX::Zero(m.numDofs());
+    for (int e = 0; e < m.numBeams(); ++e)
+      for (int node : {m.beamNodes[e][0], m.beamNodes[e][1]})
+        for (int k = 0; k < 3; ++k) { mass_[6 * node + k] += mt; mass_[6 * node + 3 + k] += jr; }
+    for (int i = 0; i < mass_.size(); ++i)
+      if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
+    invMass_ = mass_.cwiseInverse();
+    sim.addedRotaryInertia = rotaryScale_ - 1.0;
+    omegaMax_ = estimateOmegaMax(sim, invMass_);
+    bEff_ = std::min(sim.dampB, 1.0 / omegaMax_);
+    dt_ = sim.params.dt_factor * 2.0 * M_PI / omegaMax_;
+    const double xi = 0.5 * bEff_ * omegaMax_ + 0.5 * sim.dampA / omegaMax_;
+    const double limit = 2.0 / omegaMax_ * (std::sqrt(1.0 + xi * xi) - xi);
+    if (dt_ > 0.95 * limit) {
+      std::ostringstream msg;
+      msg << "time step dt = " << dt_ << " (dt_factor " << sim.params.dt_factor
+          << " x smallest period 2 pi/omega_max of the lumped system) is above the stable limit 0.95 x "
+          << limit << " (omega_max = " << omegaMax_ << ", damping ratio there " << xi
+          << "): use dt_factor <= " << 0.95 * limit * omegaMax_ / (2 * M_PI);
+      throw IntegratorError(msg.str());
+    }
+  }
+
+  std::string name() const override { return "lumped"; }
+  double timeStep() const override { return dt_; }
+  bool usesConsistentMass() const override { return false; }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
+      << ", stiffness damping b' " << bEff_;
+    return o.str();
+  }
+
+  void advance(Simulation& sim) override {
+    State& s = sim.state;  // s.v holds the half-step velocity v_{n-1/2} (checkpointable as it is)
+    const double dt = dt_, a = sim.dampA;
+    // forces at q_n (interfaces update their history here), stiffness damping at v_{n-1/2}
+    fI_.resize(s.q.size());
+    sim.computeForcesForInterfaces(s.q, fI_, true);
+    Kq_ = sim.K * s.q;
+    Kv_ = sim.K * s.v;
+    vOld_ = s.v;
+    s.v = ((1.0 - 0.5 * a * dt) * s.v - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) / (1.0 + 0.5 * a * dt);
+    // prescribed DOFs follow the loading, at the half step
+    const double Vh = sim.loading.velocity(s.time + 0.5 * dt);
+    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) s.v[sim.prescribedDofs[i]] = sim.prescribedShape[i] * Vh;
+    // reactions at t_n: R_p = (K q + f_iface + M a + C v)_p, with a and v by central differences
+    double power = 0;
+    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) {
+      const int dof = sim.prescribedDofs[i];
+      const double acc = (s.v[dof] - vOld_[dof]) / dt, vel = 0.5 * (s.v[dof] + vOld_[dof]);
+      sim.reaction[i] = Kq_[dof] + fI_[dof] + bEff_ * Kv_[dof] + mass_[dof] * (acc + a * vel);
+      power += sim.reaction[i] * vel;
+    }
+    if (s.step > 0) s.externalWork += 0.5 * dt * (s.lastExternalPower + power);
+    s.lastExternalPower = power;
+    // damping work over the step, at the half-step velocity
+    s.dampingWork += dt * (a * s.v.dot(mass_.cwiseProduct(s.v)) + bEff_ * s.v.dot(sim.K * s.v));
+    s.a = (s.v - vOld_) / dt;
+    s.q += dt * s.v;
+    s.time += dt;
+    ++s.step;
+    const VecX vHalf = s.v;
+    sim.applyBoundaryConditions(s.time);  // q of the prescribed DOFs at t_{n+1}
+    s.v = vHalf;
+  }
+
+  void onBeamsDeleted(Simulation&) override {}  // lumped mass stays; K is already updated in sim
+
+  double kineticEnergy(const Simulation& sim) const override {
+    return 0.5 * sim.state.v.dot(mass_.cwiseProduct(sim.state.v));
+  }
+
+ private:
+  double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0;
+  VecX mass_, invMass_, vOld_, fI_, Kq_, Kv_;
+};
+
 }  // namespace
 
 std::unique_ptr<Integrator> makeIntegrator(Simulation& sim) {
   const std::string& name = sim.params.integrator;
   if (name == "paper") return std::make_unique<PaperIntegrator>(sim);
-  throw IntegratorError("integrator '" + name + "' is not available in this build (available: paper)");
+  if (name == "lumped") return std::make_unique<LumpedIntegrator>(sim);
+  throw IntegratorError("integrator '" + name + "' is not available in this build (available: paper, lumped)");
 }
 
 }  // namespace enamel

@@ -155,6 +155,8 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "solver_version", ENAMEL_VERSION);
       attr(g.id, "git_hash", ENAMEL_GIT_HASH);
       attr(g.id, "integrator", sim.integrator->name());
+      attr(g.id, "integrator_details", sim.integrator->describe());
+      attr(g.id, "added_rotary_inertia", sim.addedRotaryInertia);
       attr(g.id, "linear_solver", p.linear_solver);
       attr(g.id, "deletion_rule", p.deletion_rule);
       attr(g.id, "seed", static_cast<long>(p.seed));
@@ -165,6 +167,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       for (const auto& w : rec.warnings) warnings += w + "\n";
       attr(g.id, "warnings", warnings);
       attr(g.id, "wall_time_s", rec.wallSeconds);
+      attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
       attr(g.id, "steps", rec.steps);
       attr(g.id, "written_utc", utcNow());
       attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "

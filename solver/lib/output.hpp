@@ -31,6 +31,7 @@ struct RunRecord {
   double wallSeconds = 0;
   long steps = 0;
   std::vector<std::string> warnings;      // quasi-static checks that left their bounds
+  double maxKineticRatio = 0;             // largest kinetic / strain energy while the crack grew
 };
 
 Frame captureFrame(const Simulation& sim, double targetDa);

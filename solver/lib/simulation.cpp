@@ -338,7 +338,8 @@ int Simulation::deleteOverloadedBeams() {
     const beam::Mat12 Ml = beam::rotateToGlobal(
         beam::lumpedMassDiagonal(section, model.beamLength).asDiagonal().toDenseMatrix(),
         beam::localFrame(Vec3::Zero(), model.rodDirection(ply)));
-    state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u) + 0.5 * v.dot((beamMc[ply] - Ml) * v);
+    state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u);
+    if (integrator->usesConsistentMass()) state.rodFractureEnergy += 0.5 * v.dot((beamMc[ply] - Ml) * v);
     addElementInPlace(K, beamK[ply], a, b, -1.0);
     addElementInPlace(M, beamMc[ply] - Ml, a, b, -1.0);
     state.beamBroken[e] = 1;

@@ -74,6 +74,10 @@ class Integrator {
   virtual void onBeamsDeleted(Simulation& sim) = 0;
   /// Kinetic energy 1/2 v^T M v with this integrator's mass matrix.
   virtual double kineticEnergy(const Simulation& sim) const = 0;
+  /// Whether the integrator's mass is the consistent one (sim.M); false for lumped-mass schemes.
+  virtual bool usesConsistentMass() const { return true; }
+  /// One line on the scheme's own choices (mass scaling, damping), for the output's provenance.
+  virtual std::string describe() const { return name(); }
 };
 
 class Simulation {
@@ -90,6 +94,7 @@ class Simulation {
   double E_transverse = 0, c_d = 0;  // measured transverse modulus and wave speed
   double omegaMin = 0, dampA = 0, dampB = 0;  // Rayleigh: C = dampA M + dampB K
   double omegaMaxElement = 0;        // largest beam-element frequency (consistent mass)
+  double addedRotaryInertia = 0;     // rotary inertia added by a lumped scheme, as a fraction of the physical one
   Loading loading;
   std::vector<beam::Mat12> beamLocalForceOperator;  // per ply: K_local T (u_e -> local end forces)
   std::vector<beam::Mat12> beamK, beamMc;           // per ply: global element stiffness / consistent mass

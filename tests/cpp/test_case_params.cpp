@@ -96,11 +96,11 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{5, 15, 30}));
     EXPECT_EQ(p.sourceName, "case.toml");
     EXPECT_EQ(p.presetName, "");
-    // k = 1/10, sigma0 = 1e-3 k, Gamma = 3 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
+    // k = 1/10, sigma0 = delta0 k = 0.1 k, Gamma = 3 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
     EXPECT_NEAR(p.k(), 0.1, kArithmeticTol * 0.1);
-    EXPECT_NEAR(p.sigma0(), 1e-4, kArithmeticTol * 1e-4);
-    EXPECT_NEAR(p.Gamma(), 3e-7, kArithmeticTol * 3e-7);
-    EXPECT_NEAR(p.sigma_ru(), 21.4e-4, kArithmeticTol * 21.4e-4);
+    EXPECT_NEAR(p.sigma0(), 1e-2, kArithmeticTol * 1e-2);
+    EXPECT_NEAR(p.Gamma(), 3e-3, kArithmeticTol * 3e-3);
+    EXPECT_NEAR(p.sigma_ru(), 21.4e-2, kArithmeticTol * 21.4e-2);
     EXPECT_NEAR(p.a0(), 16.0, kArithmeticTol * 16.0);
 }
 
@@ -266,18 +266,18 @@ TEST(CaseParams, LayeringDefaultsPresetFileSet) {
     // preset > defaults
     const CaseParams preset = parse("", "reduced");
     EXPECT_EQ(preset.presetName, "reduced");
-    EXPECT_EQ(preset.w_s_over_d, 80.0);
-    EXPECT_EQ(preset.h_s_over_d, 40.0);
-    EXPECT_EQ(preset.frames_da_over_d, (std::vector<double>{5, 10, 20}));
+    EXPECT_EQ(preset.w_s_over_d, 40.0);
+    EXPECT_EQ(preset.h_s_over_d, 20.0);
+    EXPECT_EQ(preset.frames_da_over_d, (std::vector<double>{3, 6, 12}));
     EXPECT_EQ(preset.zeta, 0.2);  // not in the preset: default
     // case file > preset
     const CaseParams file = parse("w_s_over_d = 50\n", "reduced");
     EXPECT_EQ(file.w_s_over_d, 50.0);
-    EXPECT_EQ(file.h_s_over_d, 40.0);
+    EXPECT_EQ(file.h_s_over_d, 20.0);
     // --set > case file, later --set > earlier
     const CaseParams set = parse("w_s_over_d = 50\n", "reduced", {"w_s_over_d=60", "w_s_over_d = 70"});
     EXPECT_EQ(set.w_s_over_d, 70.0);
-    EXPECT_EQ(set.h_s_over_d, 40.0);
+    EXPECT_EQ(set.h_s_over_d, 20.0);
 }
 
 TEST(CaseParams, SetValuesAreTomlValues) {
@@ -308,8 +308,8 @@ TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
     }
     const CaseParams ci = parse("", "ci");
     EXPECT_EQ(ci.v_app_over_cd, 2e-3);
-    EXPECT_EQ(ci.stop_da_over_d, 8.0);
-    EXPECT_EQ(ci.frames_da_over_d, (std::vector<double>{2, 4, 8}));
+    EXPECT_EQ(ci.stop_da_over_d, 5.0);
+    EXPECT_EQ(ci.frames_da_over_d, (std::vector<double>{1, 2.5, 5}));
     const CaseParams paper = parse("", "paper");
     EXPECT_EQ(paper.w_s_over_d, 200.0);
     EXPECT_EQ(paper.h_s_over_d, 200.0);
@@ -377,12 +377,12 @@ TEST(CaseParams, EffectiveTomlRoundTrips) {
     EXPECT_EQ(keyLines(q.tomlText), keyLines(p.tomlText));
     EXPECT_EQ(q.description, "quote \" and\nnewline");
     EXPECT_EQ(q.cv, 0.1);
-    EXPECT_EQ(q.w_s_over_d, 80.0);
+    EXPECT_EQ(q.w_s_over_d, 40.0);
     EXPECT_EQ(q.integrator, "lumped");
     EXPECT_EQ(q.frames_da_over_d, (std::vector<double>{1, 2.5}));
     EXPECT_EQ(q.max_steps, 12345);
     EXPECT_EQ(q.sigma_ru_over_sigma0, 21.4);  // shortest round-trip formatting keeps every bit
-    EXPECT_EQ(q.delta0_over_d, 1e-3);
+    EXPECT_EQ(q.delta0_over_d, 0.1);
 }
 
 TEST(CaseParams, LoadCaseReadsFileAndRecordsSource) {
@@ -391,7 +391,7 @@ TEST(CaseParams, LoadCaseReadsFileAndRecordsSource) {
     EXPECT_EQ(p.sourceName, path);
     EXPECT_EQ(p.cv, 0.2);
     EXPECT_EQ(p.seed, 3);
-    EXPECT_EQ(p.w_s_over_d, 32.0);
+    EXPECT_EQ(p.w_s_over_d, 16.0);
     std::remove(path.c_str());
 }
 

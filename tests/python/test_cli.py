@@ -1,0 +1,95 @@
+"""Command line: --help on every command, and bad input answered by one clear line and a distinct exit
+status before anything is allocated or written (issues "Foundation" and "Hard cases and faults")."""
+import pytest
+
+from conftest import CASES
+
+# Exit statuses (solver/lib/exit_codes.hpp).
+USAGE, MISSING_FILE, MALFORMED, UNKNOWN_KEY, WRONG_TYPE, OUT_OF_RANGE, UNWRITABLE, EXISTS = 2, 3, 4, 5, 6, 7, 8, 9
+
+GOOD = "theta_D = 0\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n"
+
+
+@pytest.mark.parametrize("args", [["--help"], ["info", "--help"], ["run", "--help"], ["keys", "--help"]])
+def test_help_explains_every_command(run, args):
+    r = run(*args)
+    assert r.returncode == 0
+    assert "Usage" in r.stdout
+    if args[0] == "run":
+        for option in ("--preset", "--set", "--out", "--force"):
+            assert option in r.stdout, option
+
+
+def test_keys_lists_every_key_with_range(run):
+    r = run("keys")
+    assert r.returncode == 0
+    for key in ("theta_D", "Er_over_kd", "sigma_ru_over_sigma0", "cv", "h_e_over_d", "v_app_over_cd"):
+        assert f"`{key}`" in r.stdout, key
+
+
+@pytest.mark.parametrize("text, status, words", [
+    (GOOD + "foo = 1\n", UNKNOWN_KEY, ["'foo'", "unknown key"]),
+    ("Er_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n", UNKNOWN_KEY, ["'theta_D'", "missing", "[0, 45]"]),
+    (GOOD.replace("theta_D = 0", 'theta_D = "x"'), WRONG_TYPE, ["'theta_D'", '"x"', "wrong type", "[0, 45]"]),
+    (GOOD.replace("theta_D = 0", "theta_D = 60"), OUT_OF_RANGE, ["'theta_D'", "60", "[0, 45]"]),
+    (GOOD + "cv = -0.1\n", OUT_OF_RANGE, ["'cv'", "-0.1", "[0, 1)"]),
+    (GOOD + "w_s_over_d = -5\n", OUT_OF_RANGE, ["'w_s_over_d'", "-5"]),
+    (GOOD + "h_e_over_d = 1.5\n", OUT_OF_RANGE, ["'h_e_over_d'", "1.5", "(0, 1]"]),
+    (GOOD + "v_app_over_cd = nan\n", OUT_OF_RANGE, ["'v_app_over_cd'", "nan"]),
+    ("theta_D = = 0\n", MALFORMED, ["malformed TOML", ":1:"]),
+])
+def test_bad_case_file_one_clear_line(run, tmp_path, text, status, words):
+    case = tmp_path / "case.toml"
+    case.write_text(text)
+    out = tmp_path / "out"
+    r = run("run", case, "--out", out)
+    assert r.returncode == status, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    assert not out.exists(), "nothing may be written before the case is valid"
+
+
+def test_missing_case_file(run, tmp_path):
+    r = run("info", tmp_path / "nope.toml")
+    assert r.returncode == MISSING_FILE
+    assert "nope.toml" in r.stderr
+
+
+def test_bad_set_override_names_key(run):
+    r = run("info", CASES / "small_theta0.toml", "--set", "h_e_over_d=nan")
+    assert r.returncode == OUT_OF_RANGE
+    assert "h_e_over_d" in r.stderr and "nan" in r.stderr
+
+
+def test_unknown_preset(run):
+    r = run("info", CASES / "small_theta0.toml", "--preset", "huge")
+    assert r.returncode == USAGE
+    assert "huge" in r.stderr
+
+
+def test_unwritable_output_directory(run, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("I am a file")
+    r = run("run", CASES / "small_theta0.toml", "--out", blocker / "sub")
+    assert r.returncode == UNWRITABLE, r.stderr
+    assert blocker.read_text() == "I am a file"
+
+
+def test_existing_output_needs_force(run, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "result.h5").write_bytes(b"precious")
+    r = run("run", CASES / "small_theta0.toml", "--out", out)
+    assert r.returncode == EXISTS, r.stderr
+    assert "--force" in r.stderr
+    assert (out / "result.h5").read_bytes() == b"precious"
+
+
+def test_info_prints_counts(run):
+    r = run("info", CASES / "small_theta0.toml")
+    assert r.returncode == 0, r.stderr
+    # hand count of the 6 d x 4 d specimen at h_e = 0.3 d (tests/cpp/test_geometry.cpp)
+    assert "168" in r.stdout and "160" in r.stdout
+    assert "bending governs" in r.stdout
