@@ -201,9 +201,12 @@ class LumpedIntegrator : public Integrator {
     const double mt = 0.5 * sim.section.rho * sim.section.A * L;
     const double jr = rotaryScale_ * 0.5 * sim.section.rho * sim.section.Ip * L;
     mass_ = VecX::Zero(m.numDofs());
-    for (int e = 0; e < m.numBeams(); ++e)
-      for (int node : {m.beamNodes[e][0], m.beamNodes[e][1]})
+    auto addElementMass = [&](int a, int b) {
+      for (int node : {a, b})
         for (int k = 0; k < 3; ++k) { mass_[6 * node + k] += mt; mass_[6 * node + 3 + k] += jr; }
+    };
+    for (int e = 0; e < m.numBeams(); ++e) addElementMass(m.beamNodes[e][0], m.beamNodes[e][1]);
+    for (const auto& ab : sim.cutBeamNodes) addElementMass(ab[0], ab[1]);  // cut by the pre-crack: mass stays
     for (int i = 0; i < mass_.size(); ++i)
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();

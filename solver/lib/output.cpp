@@ -72,13 +72,15 @@ struct Handle {
   Handle& operator=(const Handle&) = delete;
 };
 
+// Strings are variable-length UTF-8, which h5py reads back as str.
 void attr(hid_t obj, const char* name, const std::string& value) {
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "string type");
-  H5Tset_size(type.id, std::max<std::size_t>(1, value.size()));
+  H5Tset_size(type.id, H5T_VARIABLE);
   H5Tset_cset(type.id, H5T_CSET_UTF8);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose, "scalar space");
   Handle a(H5Acreate2(obj, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, name);
-  H5Awrite(a.id, type.id, value.empty() ? "" : value.c_str());
+  const char* text = value.c_str();
+  H5Awrite(a.id, type.id, &text);
 }
 void attr(hid_t obj, const char* name, const char* value) { attr(obj, name, std::string(value)); }
 void attr(hid_t obj, const char* name, double value) {

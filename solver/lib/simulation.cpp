@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include <Eigen/CholmodSupport>
@@ -188,6 +189,22 @@ Simulation::Simulation(const CaseParams& p)
   }
   K = assembleBeams(m, beamK, n);
   M = assembleBeams(m, beamMc, n);
+  // Rod elements cut by the pre-crack carry no stiffness but keep their material's mass, lumped at their
+  // nodes (as a deleted element does), so a rod end isolated by the cut is not massless.
+  {
+    std::map<std::pair<int, int>, int> nodeOf;  // (rod, slice) -> node
+    for (int i = 0; i < m.numNodes(); ++i) nodeOf[{m.nodeRod[i], m.nodeSlice[i]}] = i;
+    for (std::size_t c = 0; c < m.precrackBeamRod.size(); ++c) {
+      const int rod = m.precrackBeamRod[c], k = m.precrackBeamSlice[c];
+      cutBeamNodes.push_back({nodeOf.at({rod, k}), nodeOf.at({rod, k + 1})});
+      const int ply = m.rodPly[rod];
+      const beam::Mat12 Ml = beam::rotateToGlobal(
+          beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(),
+          beam::localFrame(Vec3::Zero(), m.rodDirection(ply)));
+      addElementInPlace(M, Ml, cutBeamNodes.back()[0], cutBeamNodes.back()[1], +1.0);
+    }
+    M.makeCompressed();
+  }
   omegaMaxElement = beam::maxFrequency(section, m.beamLength, beam::MassKind::Consistent);
 
   // Wave speed and Rayleigh damping (paper eq. 1-3, DESIGN section 4): C = a M + b K,

@@ -3,6 +3,7 @@
 // measurements (J at the outer boundary, crack advance, energy balance). DESIGN.md sections 3-5.
 //
 // State lives in plain arrays in one struct (State), which is all a checkpoint needs besides the case.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -105,6 +106,7 @@ class Simulation {
   std::vector<int> prescribedDofs;
   std::vector<double> prescribedShape;
   std::vector<int> freeDofs;
+  std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack
   std::vector<int> dofToFree;  // -1 for prescribed
   // Interface adjacency (node -> interface ends) for a deterministic gather of interface forces.
   std::vector<int> nodeIfaceStart, nodeIfaceList;  // CSR; entries are 2*iface + side (0 = A, 1 = B)
