@@ -68,7 +68,10 @@ def test_theta30_runs_to_stop_with_rising_rcurve(theta30):
     broken = int(theta30["history/broken_rod_elements"][-1])
     R = theta30["rcurve/R_over_Gamma"][:]
     rc = theta30["rcurve"].attrs
-    err = np.abs(theta30["history/energy_balance_error"][:]).max()
+    # balance error relative to the external work, once that is 1% of its final value (before, the ratio
+    # of two tiny numbers says nothing)
+    work = theta30["history/external_work"][:]
+    err = np.abs(theta30["history/energy_balance_error"][:][work > 0.01 * work[-1]]).max()
     print(f"theta30 ci: R_init {rc['R_init_over_Gamma']:.3f}  R_end {R[-1]:.3f}  R_max {R.max():.3f}  "
           f"broken rods {broken}  max |balance error| {err:.2e}")
     assert R.max() > 1.5 * R[0], "rising R-curve"
