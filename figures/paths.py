@@ -1,0 +1,22 @@
+"""The one place that defines the pipeline's paths: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/."""
+import pathlib
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+PAPER_CASES = ROOT / "paper_cases"
+FIGURE_LIST = PAPER_CASES / "figures.toml"
+RUNS = ROOT / "runs"
+FIGURES_OUT = ROOT / "figures" / "out"
+
+
+def case_file(case: str) -> pathlib.Path:
+    """The TOML file of a paper case, by name (e.g. 'theta30_s21.4_e10_cv0')."""
+    return PAPER_CASES / f"{case}.toml"
+
+
+def result_file(preset: str, case: str, slow: bool = False) -> pathlib.Path:
+    """The HDF5 result of one run; `slow` runs are the half-rate twins."""
+    return RUNS / preset / (f"{case}_slow" if slow else case) / "result.h5"
+
+
+def figure_dir(preset: str) -> pathlib.Path:
+    return FIGURES_OUT / preset
