@@ -237,37 +237,38 @@ class LumpedIntegrator : public Integrator {
   }
 
   void advance(Simulation& sim) override {
-    State& s = sim.state;  // s.v holds the half-step velocity v_{n-1/2} (checkpointable as it is)
+    State& s = sim.state;  // s.v holds the half-step velocity v_{n-1/2} (checkpointable as it is); s.a is unused
     const double dt = dt_, a = sim.dampA;
+    const std::vector<int>& pres = sim.prescribedDofs;
     // forces at q_n (interfaces update their history here), stiffness damping at v_{n-1/2}
     fI_.resize(s.q.size());
     sim.computeForcesForInterfaces(s.q, fI_, true);
     Kq_ = sim.K * s.q;
     Kv_ = sim.K * s.v;
-    vOld_ = s.v;
+    vPresOld_.resize(pres.size());
+    for (std::size_t i = 0; i < pres.size(); ++i) vPresOld_[i] = s.v[pres[i]];
     s.v = ((1.0 - 0.5 * a * dt) * s.v - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) / (1.0 + 0.5 * a * dt);
     // prescribed DOFs follow the loading, at the half step
     const double Vh = sim.loading.velocity(s.time + 0.5 * dt);
-    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) s.v[sim.prescribedDofs[i]] = sim.prescribedShape[i] * Vh;
+    for (std::size_t i = 0; i < pres.size(); ++i) s.v[pres[i]] = sim.prescribedShape[i] * Vh;
     // reactions at t_n: R_p = (K q + f_iface + M a + C v)_p, with a and v by central differences
     double power = 0;
-    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) {
-      const int dof = sim.prescribedDofs[i];
-      const double acc = (s.v[dof] - vOld_[dof]) / dt, vel = 0.5 * (s.v[dof] + vOld_[dof]);
+    for (std::size_t i = 0; i < pres.size(); ++i) {
+      const int dof = pres[i];
+      const double acc = (s.v[dof] - vPresOld_[i]) / dt, vel = 0.5 * (s.v[dof] + vPresOld_[i]);
       sim.reaction[i] = Kq_[dof] + fI_[dof] + bEff_ * Kv_[dof] + mass_[dof] * (acc + a * vel);
       power += sim.reaction[i] * vel;
     }
     if (s.step > 0) s.externalWork += 0.5 * dt * (s.lastExternalPower + power);
     s.lastExternalPower = power;
-    // damping work over the step, at the half-step velocity
-    s.dampingWork += dt * (a * s.v.dot(mass_.cwiseProduct(s.v)) + bEff_ * s.v.dot(sim.K * s.v));
-    s.a = (s.v - vOld_) / dt;
+    // damping work over the step: the step's displacement dt v_{n+1/2} against the damping force, its
+    // stiffness part as applied (at the lagged velocity)
+    s.dampingWork += dt * (a * s.v.dot(mass_.cwiseProduct(s.v)) + bEff_ * s.v.dot(Kv_));
     s.q += dt * s.v;
     s.time += dt;
     ++s.step;
-    const VecX vHalf = s.v;
-    sim.applyBoundaryConditions(s.time);  // q of the prescribed DOFs at t_{n+1}
-    s.v = vHalf;
+    sim.applyBoundaryConditions(s.time);  // q of the prescribed DOFs at t_{n+1} (it also sets their v to t_{n+1}):
+    for (std::size_t i = 0; i < pres.size(); ++i) s.v[pres[i]] = sim.prescribedShape[i] * Vh;  // keep v_{n+1/2}
   }
 
   void onBeamsDeleted(Simulation&) override {}  // lumped mass stays; K is already updated in sim
@@ -278,7 +279,7 @@ class LumpedIntegrator : public Integrator {
 
  private:
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0;
-  VecX mass_, invMass_, vOld_, fI_, Kq_, Kv_;
+  VecX mass_, invMass_, vPresOld_, fI_, Kq_, Kv_;
 };
 
 }  // namespace

@@ -95,11 +95,12 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
       }
       const double strain = r.strainBeams + r.strainInterfaces;
       // Quasi-static check while the crack grows (before it, the ratio only says how far the load has come).
-      if (s.crackAdvance > 0 && strain > 0) rec.maxKineticRatio = std::max(rec.maxKineticRatio, r.kinetic / strain);
-      if (!warnedKinetic && s.crackAdvance > 0 && strain > 0 && r.kinetic / strain > kKineticWarn) {
+      const double kineticRatio = s.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
+      rec.maxKineticRatio = std::max(rec.maxKineticRatio, kineticRatio);
+      if (!warnedKinetic && kineticRatio > kKineticWarn) {
         warnedKinetic = true;
         rec.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
-                                   r.kinetic / strain, s.step, kKineticWarn));
+                                   kineticRatio, s.step, kKineticWarn));
       }
       const double w = wall();
       if (opt.progress && (w - lastProgress > 2.0)) {

@@ -183,6 +183,7 @@ Simulation::Simulation(const CaseParams& p)
     const beam::Mat3 R = beam::localFrame(Vec3::Zero(), xb);
     beamK.push_back(beam::globalStiffness(section, Vec3::Zero(), xb));
     beamMc.push_back(beam::globalConsistentMass(section, Vec3::Zero(), xb));
+    beamMl.push_back(beam::rotateToGlobal(beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(), R));
     beam::Mat12 T = beam::Mat12::Zero();
     for (int blk = 0; blk < 4; ++blk) T.block<3, 3>(3 * blk, 3 * blk) = R;
     beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
@@ -197,11 +198,7 @@ Simulation::Simulation(const CaseParams& p)
     for (std::size_t c = 0; c < m.precrackBeamRod.size(); ++c) {
       const int rod = m.precrackBeamRod[c], k = m.precrackBeamSlice[c];
       cutBeamNodes.push_back({nodeOf.at({rod, k}), nodeOf.at({rod, k + 1})});
-      const int ply = m.rodPly[rod];
-      const beam::Mat12 Ml = beam::rotateToGlobal(
-          beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(),
-          beam::localFrame(Vec3::Zero(), m.rodDirection(ply)));
-      addElementInPlace(M, Ml, cutBeamNodes.back()[0], cutBeamNodes.back()[1], +1.0);
+      addElementInPlace(M, beamMl[m.rodPly[rod]], cutBeamNodes.back()[0], cutBeamNodes.back()[1], +1.0);
     }
     M.makeCompressed();
   }
@@ -352,9 +349,7 @@ int Simulation::deleteOverloadedBeams() {
     const int a = model.beamNodes[e][0], b = model.beamNodes[e][1];
     const int ply = model.rodPly[model.beamRod[e]];
     const beam::Vec12 u = gatherElement(state.q, a, b), v = gatherElement(state.v, a, b);
-    const beam::Mat12 Ml = beam::rotateToGlobal(
-        beam::lumpedMassDiagonal(section, model.beamLength).asDiagonal().toDenseMatrix(),
-        beam::localFrame(Vec3::Zero(), model.rodDirection(ply)));
+    const beam::Mat12& Ml = beamMl[ply];
     state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u);
     if (integrator->usesConsistentMass()) state.rodFractureEnergy += 0.5 * v.dot((beamMc[ply] - Ml) * v);
     addElementInPlace(K, beamK[ply], a, b, -1.0);

@@ -98,7 +98,7 @@ class Simulation {
   double addedRotaryInertia = 0;     // rotary inertia added by a lumped scheme, as a fraction of the physical one
   Loading loading;
   std::vector<beam::Mat12> beamLocalForceOperator;  // per ply: K_local T (u_e -> local end forces)
-  std::vector<beam::Mat12> beamK, beamMc;           // per ply: global element stiffness / consistent mass
+  std::vector<beam::Mat12> beamK, beamMc, beamMl;   // per ply: global element stiffness / consistent / lumped mass
 
   // Rod matrices (rods only: interfaces are never assembled). Updated when rod elements are deleted.
   SpMat K, M;
