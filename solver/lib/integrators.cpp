@@ -90,6 +90,21 @@ class PaperIntegrator : public Integrator {
     s.lastExternalPower = power;
   }
 
+  void initialise(Simulation& sim) override {
+    State& s = sim.state;
+    sim.applyBoundaryConditions(s.time);
+    fI_.resize(s.q.size());
+    sim.computeForcesForInterfaces(s.q, fI_, false);
+    r_ = -fI_ - sim.K * s.q - sim.dampB * (sim.K * s.v) - sim.dampA * (sim.M * s.v);
+    VecX ap(sim.prescribedDofs.size());
+    for (std::size_t i = 0; i < ap.size(); ++i) ap[i] = s.a[sim.prescribedDofs[i]];
+    rf_.resize(sim.freeDofs.size());
+    for (std::size_t i = 0; i < sim.freeDofs.size(); ++i) rf_[i] = r_[sim.freeDofs[i]];
+    rf_ -= Hfp_ * ap;
+    af_ = useUmfpack_ ? VecX(lu_.solve(rf_)) : VecX(chol_.solve(rf_));
+    for (std::size_t i = 0; i < sim.freeDofs.size(); ++i) s.a[sim.freeDofs[i]] = af_[i];
+  }
+
   void onBeamsDeleted(Simulation& sim) override { factorise(sim, false); }
 
   double kineticEnergy(const Simulation& sim) const override {
@@ -168,7 +183,8 @@ double estimateOmegaMax(Simulation& sim, const VecX& invMass) {
     seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
     x[dof] = static_cast<double>(seed >> 11) / 9007199254740992.0 - 0.5;
   }
-  const double amplitude = 1e-3 * sim.law.delta0();
+  // the case's delta0 (not the law's: unbreakable interfaces have an infinite one)
+  const double amplitude = 1e-3 * sim.params.sigma0() / sim.params.k();
   double lambda = 0;
   for (int it = 0; it < 300; ++it) {
     x *= amplitude / x.cwiseAbs().maxCoeff();
@@ -269,6 +285,17 @@ class LumpedIntegrator : public Integrator {
     ++s.step;
     sim.applyBoundaryConditions(s.time);  // q of the prescribed DOFs at t_{n+1} (it also sets their v to t_{n+1}):
     for (std::size_t i = 0; i < pres.size(); ++i) s.v[pres[i]] = sim.prescribedShape[i] * Vh;  // keep v_{n+1/2}
+  }
+
+  void initialise(Simulation& sim) override {
+    State& s = sim.state;
+    sim.applyBoundaryConditions(s.time);
+    fI_.resize(s.q.size());
+    sim.computeForcesForInterfaces(s.q, fI_, false);
+    const VecX acc = -invMass_.cwiseProduct(fI_ + sim.K * s.q + bEff_ * (sim.K * s.v)) - sim.dampA * s.v;
+    for (int dof : sim.freeDofs) s.v[dof] -= 0.5 * dt_ * acc[dof];
+    const double Vh = sim.loading.velocity(s.time - 0.5 * dt_);
+    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) s.v[sim.prescribedDofs[i]] = sim.prescribedShape[i] * Vh;
   }
 
   void onBeamsDeleted(Simulation&) override {}  // lumped mass stays; K is already updated in sim

@@ -71,6 +71,10 @@ class Integrator {
   /// Advance sim.state from t_n to t_n + dt (positions, boundary conditions, forces, accelerations,
   /// velocities, reactions at the prescribed DOFs, damping work).
   virtual void advance(Simulation& sim) = 0;
+  /// Make the integrator's own state consistent with a given q, v at state.time (a run from rest needs
+  /// nothing): `paper` solves for the accelerations, H a = -f_iface(q) - K q - C v; `lumped` turns v into
+  /// the half-step velocity v_{-1/2} = v - dt/2 M^-1 (-f_iface(q) - K q - C v). Used for initial-value tests.
+  virtual void initialise(Simulation& sim) = 0;
   /// The rod elements just deleted (their K and M are already updated in sim).
   virtual void onBeamsDeleted(Simulation& sim) = 0;
   /// Kinetic energy 1/2 v^T M v with this integrator's mass matrix.
