@@ -3,6 +3,13 @@
 #   make deps     install the Debian packages the project needs (idempotent; needs root to install)
 #   make build    configure and build the solver and the C++ tests (Release)
 #   make test     all C++ and Python tests (runs deps and build first when needed)
+#
+#   make figures  [PRESET=ci|reduced|paper]  every run of Figs. 4-9, then the figures and the summary table
+#                 under figures/out/<preset>/ (default PRESET=reduced; use `make -j2 figures` for 2 runs at once)
+#   make runs     [PRESET=...]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
+#   make vtk      [PRESET=...]  ParaView files (XDMF) of every finished run, next to its result.h5
+#   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
+#   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 
 SHELL := /bin/bash
 BUILD_DIR ?= build
@@ -22,8 +29,12 @@ PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
     echo /usr/bin/python3)
 
 ENAMEL := $(BUILD_DIR)/enamel-dem
+PRESET ?= reduced
+PRESETS := ci reduced paper
+RUNS := runs
+FIG_OUT := figures/out/$(PRESET)
 
-.PHONY: help deps build test test-cpp test-python clean
+.PHONY: help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -58,3 +69,70 @@ test-python:
 
 clean:
 	rm -rf $(BUILD_DIR)
+
+# --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
+# The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.
+SOLVER_SOURCES := $(wildcard solver/lib/*.cpp solver/lib/*.hpp solver/app/*.cpp) CMakeLists.txt
+$(ENAMEL): $(SOLVER_SOURCES) | deps $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target enamel-dem
+
+# Which figure uses which case: generated from paper_cases/figures.toml (FIG4_CASES, ..., ALL_CASES, ALL_SLOW).
+$(BUILD_DIR)/figures.mk: paper_cases/figures.toml pipeline/make_rules.py figures/paths.py
+	$(PYTHON) pipeline/make_rules.py $@
+-include $(BUILD_DIR)/figures.mk
+
+run_targets = $(foreach c,$(1),$(RUNS)/$(PRESET)/$(c)/result.h5) $(foreach c,$(2),$(RUNS)/$(PRESET)/$(c)_slow/result.h5)
+ALL_RUNS := $(call run_targets,$(ALL_CASES),$(ALL_SLOW))
+
+check-preset:
+	@case " $(PRESETS) " in *" $(PRESET) "*) ;; *) \
+	  echo "make: PRESET=$(PRESET) is not a preset (allowed: $(PRESETS))" >&2; exit 2;; esac
+
+# One run. A run that fails keeps its partial result readable as result.failed.h5 (and make stops, or goes on
+# with -k); result.h5 only ever holds a finished run, so the next `make` re-runs a failed one.
+define run_case
+	@mkdir -p $(@D)
+	@echo "run: $(@D)"
+	@$(ENAMEL) run $< --preset $(PRESET) --out $(@D) --force $(1) 2> $(@D)/log.txt \
+	  || { rc=$$?; mv -f $@ $(@D)/result.failed.h5 2>/dev/null; tail -n 3 $(@D)/log.txt >&2; \
+	       echo "run: $(@D) failed (exit $$rc); partial result in $(@D)/result.failed.h5, log in $(@D)/log.txt" >&2; exit $$rc; }
+	@tail -n 2 $(@D)/log.txt
+endef
+
+$(RUNS)/$(PRESET)/%_slow/result.h5: paper_cases/%.toml $(ENAMEL) | check-preset
+	$(call run_case,--set rate_factor=0.5)
+
+$(RUNS)/$(PRESET)/%/result.h5: paper_cases/%.toml $(ENAMEL) | check-preset
+	$(call run_case,)
+
+runs: check-preset $(ALL_RUNS)
+
+# Figures: one script per figure (figures/figN_*.py), reading only the HDF5 results of its runs.
+fig_script = $(wildcard figures/$(1)_*.py)
+FIG_COMMON := figures/common.py figures/paths.py figures/paper_values.toml
+define figure_rule
+$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(1)))).png: $(call fig_script,$(1)) $(FIG_COMMON) \
+    $(call run_targets,$($(shell echo $(1) | tr a-z A-Z)_CASES),$($(shell echo $(1) | tr a-z A-Z)_SLOW))
+	$(PYTHON) $$< --preset $(PRESET)
+endef
+$(foreach f,$(FIGURES),$(eval $(call figure_rule,$(f))))
+FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(f)))).png)
+
+$(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
+	$(PYTHON) $< --preset $(PRESET)
+
+figures: check-preset build $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
+	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
+
+# ParaView: one XDMF time series per finished run (rods and interfaces), next to its result.h5.
+vtk: check-preset
+	@found=0; for h in $(RUNS)/$(PRESET)/*/result.h5; do [ -f "$$h" ] || continue; found=1; \
+	  d=$$(dirname $$h)/vtk; if [ ! -d "$$d" ] || [ "$$h" -nt "$$d" ]; then \
+	    $(PYTHON) pipeline/export_vtk.py $$h $$d || exit 1; touch $$d; fi; done; \
+	if [ $$found = 0 ]; then echo "vtk: no finished runs under $(RUNS)/$(PRESET)/: run 'make runs PRESET=$(PRESET)' first" >&2; exit 1; fi
+
+reference: build
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) tests/reference/make_reference.py
+
+clean-runs: check-preset
+	rm -rf $(RUNS)/$(PRESET) $(FIG_OUT)

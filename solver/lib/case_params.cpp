@@ -74,6 +74,9 @@ const std::vector<KeySpec>& caseKeys() {
          "fraction of the crisscross spacing d/sin(theta_D) (no effect at theta_D = 0)"},
         {"v_app_over_cd", Kind::Real, "numerics", false, 1e-3, 0, 0.1, O, C, "", "", "c_d",
          "loading rate: peak applied velocity at the cracked edge / transverse wave speed c_d"},
+        {"rate_factor", Kind::Real, "numerics", false, 1, 0, 1e3, O, C, "", "", "-",
+         "loading-rate multiplier: v_app = rate_factor x v_app_over_cd x c_d; the pipeline's half-rate "
+         "twins (paper: 50% slower loading) use 0.5 on top of the preset's rate"},
         {"ramp_transits", Kind::Real, "numerics", false, 1, 0, 1e3, C, C, "", "", "h_s/c_d",
          "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d"},
         {"zeta", Kind::Real, "numerics", false, 0.2, 0, 1, C, C, "", "", "-",
@@ -173,6 +176,7 @@ const std::vector<Binding>& bindings() {
         {"h_e_over_d", &P::h_e_over_d},
         {"crisscross_phase", &P::crisscross_phase},
         {"v_app_over_cd", &P::v_app_over_cd},
+        {"rate_factor", &P::rate_factor},
         {"ramp_transits", &P::ramp_transits},
         {"zeta", &P::zeta},
         {"dt_factor", &P::dt_factor},

@@ -62,6 +62,7 @@ struct CaseParams {
     double h_e_over_d = 0;             // slice spacing / d
     double crisscross_phase = 0;       // first crisscross point ahead of the tip, in d/sin(theta)
     double v_app_over_cd = 0;          // peak applied velocity / c_d
+    double rate_factor = 1;            // multiplier on v_app (half-rate twins: 0.5)
     double ramp_transits = 0;          // velocity ramp duration / (h_s/c_d)
     double zeta = 0;                   // Rayleigh damping ratio at w_min = pi c_d / h_s
     double dt_factor = 0;              // dt / smallest element period (integrator "paper")

@@ -211,7 +211,7 @@ Simulation::Simulation(const CaseParams& p)
   omegaMin = M_PI * c_d / m.h_s;
   dampA = p.zeta * omegaMin;
   dampB = p.zeta / omegaMin;
-  loading.vApp = p.v_app_over_cd * c_d;
+  loading.vApp = p.rate_factor * p.v_app_over_cd * c_d;
   loading.rampTime = p.ramp_transits * m.h_s / c_d;
 
   // Prescribed DOFs: u_y of the top (+) and bottom (-) rows, graded 1 - x/w_s.
