@@ -7,7 +7,7 @@
 #   make figures  [PRESET=ci|reduced|paper]  every run of Figs. 4-9, then the figures and the summary table
 #                 under figures/out/<preset>/ (default PRESET=reduced; use `make -j2 figures` for 2 runs at once)
 #   make runs     [PRESET=...]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
-#   make vtk      [PRESET=...]  ParaView files (XDMF) of every finished run, next to its result.h5
+#   make vtk      [PRESET=...]  ParaView files (.pvd + .vtu series) of every finished run, in runs/<preset>/<case>/vtk/
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 
@@ -124,7 +124,7 @@ $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
 figures: check-preset build $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
 
-# ParaView: one XDMF time series per finished run (rods and interfaces), next to its result.h5.
+# ParaView: one .pvd + .vtu time series per finished run (rods and interfaces), in runs/<preset>/<case>/vtk/.
 vtk: check-preset
 	@found=0; for h in $(RUNS)/$(PRESET)/*/result.h5; do [ -f "$$h" ] || continue; found=1; \
 	  d=$$(dirname $$h)/vtk; if [ ! -d "$$d" ] || [ "$$h" -nt "$$d" ]; then \

@@ -4,6 +4,7 @@ import pathlib
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAPER_CASES = ROOT / "paper_cases"
 FIGURE_LIST = PAPER_CASES / "figures.toml"
+PAPER_VALUES = ROOT / "figures" / "paper_values.toml"
 RUNS = ROOT / "runs"
 FIGURES_OUT = ROOT / "figures" / "out"
 
@@ -13,10 +14,16 @@ def case_file(case: str) -> pathlib.Path:
     return PAPER_CASES / f"{case}.toml"
 
 
-def result_file(preset: str, case: str, slow: bool = False) -> pathlib.Path:
-    """The HDF5 result of one run; `slow` runs are the half-rate twins."""
-    return RUNS / preset / (f"{case}_slow" if slow else case) / "result.h5"
+def result_file(preset: str, case: str, slow: bool = False, runs: pathlib.Path = None) -> pathlib.Path:
+    """The HDF5 result of one run; `slow` runs are the half-rate twins. `runs` replaces the runs/ root (tests)."""
+    return pathlib.Path(runs or RUNS) / preset / (f"{case}_slow" if slow else case) / "result.h5"
 
 
-def figure_dir(preset: str) -> pathlib.Path:
-    return FIGURES_OUT / preset
+def figure_dir(preset: str, out: pathlib.Path = None) -> pathlib.Path:
+    """Where the figures of one preset go; `out` replaces the figures/out/ root (tests)."""
+    return pathlib.Path(out or FIGURES_OUT) / preset
+
+
+def make_command(preset: str) -> str:
+    """The command that produces the result files of one preset."""
+    return f"make runs PRESET={preset}"

@@ -91,23 +91,37 @@ int prepareOutput(const std::string& dir, bool force, std::string& resultPath) {
   return exit_code::ok;
 }
 
-int runRun(const CaseArgs& args, std::string outDir, bool force, bool quiet) {
+struct RunFlags {
+  std::string outDir;
+  bool force = false, quiet = false, restart = false;
+  double checkpointEvery = -1;  // < 0: the case key checkpoint_interval_s
+};
+
+int runRun(const CaseArgs& args, RunFlags flags) {
+  std::string& outDir = flags.outDir;
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
   if (outDir.empty())
     outDir = (fs::path("runs") / (p.presetName.empty() ? "default" : p.presetName) / fs::path(p.sourceName).stem())
                  .string();
   std::string resultPath;
-  if (int rc = prepareOutput(outDir, force, resultPath)) return rc;
+  const std::string checkpointPath = (fs::path(outDir) / "checkpoint.bin").string();
+  if (flags.restart && !fs::exists(checkpointPath))
+    return fail(exit_code::missing_file, "--restart: no checkpoint '" + checkpointPath +
+                                             "' (a run writes one every checkpoint_interval_s and on SIGINT/SIGTERM)");
+  if (int rc = prepareOutput(outDir, flags.force || flags.restart, resultPath)) return rc;
   Simulation sim(p);
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
-  if (!quiet)
+  if (!flags.quiet)
     std::fprintf(stderr, "enamel-dem: %s: %d DOF, %d interfaces, dt %.3g, integrator %s -> %s\n",
                  p.sourceName.c_str(), sim.model.numDofs(), sim.model.numInterfaces(), sim.integrator->timeStep(),
                  sim.integrator->name().c_str(), resultPath.c_str());
   RunOptions opt;
   opt.resultPath = resultPath;
-  opt.progress = !quiet;
+  opt.progress = !flags.quiet;
+  opt.checkpointPath = checkpointPath;
+  opt.checkpointIntervalSeconds = flags.checkpointEvery >= 0 ? flags.checkpointEvery : p.checkpoint_interval_s;
+  opt.restart = flags.restart;
   const RunRecord rec = runSimulation(sim, opt);
   const RcurveSummary s = [&] {
     std::vector<double> R;
@@ -140,11 +154,17 @@ int main(int argc, char** argv) {
 
   CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5");
   runArgs.addTo(run);
-  std::string outDir;
-  bool force = false, quiet = false;
-  run->add_option("--out,-o", outDir, "output directory (default runs/<preset>/<case name>)");
-  run->add_flag("--force", force, "overwrite an existing result.h5");
-  run->add_flag("--quiet,-q", quiet, "no progress lines");
+  RunFlags flags;
+  run->add_option("--out,-o", flags.outDir, "output directory (default runs/<preset>/<case name>)");
+  run->add_flag("--force", flags.force, "overwrite an existing result.h5");
+  run->add_flag("--quiet,-q", flags.quiet, "no progress lines");
+  run->add_flag("--restart", flags.restart,
+                "continue from DIR/checkpoint.bin (same case, --preset and --set as the first run); the result "
+                "is the same as an uninterrupted run's, bit for bit at the same thread count");
+  run->add_option("--checkpoint-every", flags.checkpointEvery,
+                  "write DIR/checkpoint.bin every this many wall-clock seconds (default: the case key "
+                  "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
 
   CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
 
@@ -164,9 +184,11 @@ int main(int argc, char** argv) {
   try {
     if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
     if (*info) return runInfo(infoArgs);
-    if (*run) return runRun(runArgs, outDir, force, quiet);
+    if (*run) return runRun(runArgs, flags);
   } catch (const CaseError& e) {
     return fail(e.exitCode, e.what());
+  } catch (const CheckpointError& e) {
+    return fail(exit_code::checkpoint_invalid, e.what());
   } catch (const IntegratorError& e) {
     return fail(exit_code::out_of_range, e.what());
   } catch (const std::invalid_argument& e) {

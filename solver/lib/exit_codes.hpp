@@ -15,6 +15,7 @@ constexpr int output_unwritable = 8;  // output directory or result file cannot 
 constexpr int output_exists = 9;      // result file already exists and overwriting was not requested
 constexpr int run_unstable = 10;      // run diverged: non-finite state, energy balance or kinetic ratio out of bounds
 constexpr int run_failed = 11;        // run stopped on another internal error (solver factorisation, ...)
-constexpr int interrupted = 12;       // run stopped by a signal (SIGINT/SIGTERM); a checkpoint may remain
+constexpr int interrupted = 12;       // run stopped by a signal (SIGINT/SIGTERM); a checkpoint remains for --restart
+constexpr int checkpoint_invalid = 13;  // --restart: the checkpoint is truncated, of another version or another case
 
 }  // namespace enamel::exit_code

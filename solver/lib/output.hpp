@@ -32,6 +32,7 @@ struct RunRecord {
   long steps = 0;
   std::vector<std::string> warnings;      // quasi-static checks that left their bounds
   double maxKineticRatio = 0;             // largest kinetic / strain energy while the crack grew
+  bool warnedBalance = false, warnedKinetic = false;  // each warning is recorded once
 };
 
 Frame captureFrame(const Simulation& sim, double targetDa);

@@ -32,7 +32,8 @@ void requestStop(int signal) { gStopSignal = signal; }
 RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
-  auto wall = [&] { return std::chrono::duration<double>(clock::now() - start).count(); };
+  double wallBefore = 0;  // wall time of the run before a restart
+  auto wall = [&] { return wallBefore + std::chrono::duration<double>(clock::now() - start).count(); };
   const CaseParams& p = sim.params;
   const double dt = sim.integrator->timeStep();
   const double Gamma = p.Gamma();
@@ -45,7 +46,16 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
   std::vector<double> frameTargets = p.frames_da_over_d;
   std::sort(frameTargets.begin(), frameTargets.end());
   double lastWrite = 0, lastProgress = 0, lastDa = 0;
-  bool warnedBalance = false, warnedKinetic = false;
+  bool& warnedBalance = rec.warnedBalance;
+  bool& warnedKinetic = rec.warnedKinetic;
+  double lastCheckpoint = 0;
+  auto checkpoint = [&] {
+    if (opt.checkpointPath.empty()) return;
+    rec.wallSeconds = wall();
+    rec.steps = sim.state.step;
+    writeCheckpoint(opt.checkpointPath, sim, rec);
+    lastCheckpoint = rec.wallSeconds;
+  };
   const double minWork = kBalanceMinWork * Gamma * sim.model.B;
   auto save = [&] {
     rec.wallSeconds = wall();
@@ -58,7 +68,16 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     rec.stopReason = why;
   };
 
-  rec.history.push_back(sim.measure());
+  if (opt.restart) {
+    readCheckpoint(opt.checkpointPath, sim, rec);
+    rec.status = "running";
+    rec.stopReason.clear();
+    wallBefore = lastCheckpoint = rec.wallSeconds;
+    lastDa = rec.rcurveDa.empty() ? 0.0 : rec.rcurveDa.back();
+    nextFrame = rec.frames.size();  // frames are taken in the order of their sorted targets
+  } else {
+    rec.history.push_back(sim.measure());
+  }
   save();
   while (true) {
     sim.step();
@@ -131,14 +150,17 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
       rec.stopReason = fmt("interrupted by signal %.0f", gStopSignal);
     if (!rec.stopReason.empty()) {
       rec.status = gStopSignal ? "interrupted" : "completed";
+      if (gStopSignal) checkpoint();  // the state after this step: a restart continues from here
       break;
     }
+    if (opt.checkpointIntervalSeconds > 0 && wall() - lastCheckpoint > opt.checkpointIntervalSeconds) checkpoint();
   }
   if (opt.progress && tty) std::fprintf(stderr, "\n");
   if (rec.status != "failed" || rec.history.empty() || rec.history.back().step != sim.state.step)
     rec.history.push_back(sim.measure());
   rec.frames.push_back(captureFrame(sim, -1.0));
   save();
+  if (rec.status == "completed" && !opt.checkpointPath.empty()) std::remove(opt.checkpointPath.c_str());
   return rec;
 }
 

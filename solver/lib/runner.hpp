@@ -3,6 +3,7 @@
 // checks, progress on stderr, and the result file (written whole and atomically, also during the run).
 #include <string>
 
+#include "checkpoint.hpp"
 #include "output.hpp"
 #include "simulation.hpp"
 
@@ -12,10 +13,15 @@ struct RunOptions {
   std::string resultPath;            // result.h5 to write
   bool progress = true;              // progress lines on stderr
   double writeIntervalSeconds = 30;  // rewrite the (partial) result file this often
+  std::string checkpointPath;        // checkpoint file (empty: none)
+  double checkpointIntervalSeconds = 0;  // write a checkpoint this often (wall clock; 0: only on SIGINT/SIGTERM)
+  bool restart = false;              // continue from checkpointPath instead of starting from rest
 };
 
 /// Run to a stop criterion. Never throws for a run that goes unstable: the record's status says
-/// "failed" and stopReason says which quantity, at which step, with which value.
+/// "failed" and stopReason says which quantity, at which step, with which value. With a checkpoint path,
+/// checkpoints are written every checkpointIntervalSeconds and when a signal stops the run, and removed when
+/// the run completes; `restart` continues from the last one (CheckpointError when there is none).
 RunRecord runSimulation(Simulation& sim, const RunOptions& opt);
 
 /// Ask a running simulation to stop at the next step (signal handlers call this).

@@ -352,13 +352,26 @@ int Simulation::deleteOverloadedBeams() {
     const beam::Mat12& Ml = beamMl[ply];
     state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u);
     if (integrator->usesConsistentMass()) state.rodFractureEnergy += 0.5 * v.dot((beamMc[ply] - Ml) * v);
-    addElementInPlace(K, beamK[ply], a, b, -1.0);
-    addElementInPlace(M, beamMc[ply] - Ml, a, b, -1.0);
+    removeBeamFromMatrices(e);
     state.beamBroken[e] = 1;
+    state.deletionOrder.push_back(e);
     ++state.brokenBeams;
   }
   integrator->onBeamsDeleted(*this);
   return static_cast<int>(lastDeleted.size());
+}
+
+// K loses the element's stiffness; M keeps its lumped mass (consistent minus lumped is removed).
+void Simulation::removeBeamFromMatrices(int e) {
+  const int a = model.beamNodes[e][0], b = model.beamNodes[e][1];
+  const int ply = model.rodPly[model.beamRod[e]];
+  addElementInPlace(K, beamK[ply], a, b, -1.0);
+  addElementInPlace(M, beamMc[ply] - beamMl[ply], a, b, -1.0);
+}
+
+void Simulation::replayDeletions() {
+  for (int e : state.deletionOrder) removeBeamFromMatrices(e);
+  if (!state.deletionOrder.empty()) integrator->onBeamsDeleted(*this);
 }
 
 /// One time step: advance positions, boundary conditions, forces for beams and interfaces, accelerations and

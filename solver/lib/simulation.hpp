@@ -30,6 +30,7 @@ struct State {
   VecX q, v, a;                        // displacements/rotations, velocities, accelerations (6 per node)
   std::vector<double> lambdaMax;       // per interface: largest effective separation reached
   std::vector<std::uint8_t> beamBroken;  // per rod element: deleted
+  std::vector<int> deletionOrder;        // rod elements in the order they were deleted (K, M are rebuilt so)
   // energy accumulators (time integrals)
   double externalWork = 0;             // int F_reaction . v_prescribed dt
   double dampingWork = 0;              // int v . C v dt
@@ -132,6 +133,12 @@ class Simulation {
   void computeStressRatiosForBeams(const VecX& q, std::vector<double>& ratio) const;
   /// Delete the rod elements whose stress reached their strength (rule: deletion_rule). Returns how many.
   int deleteOverloadedBeams();
+  /// After a checkpoint restored state.deletionOrder into a freshly built simulation: remove those rod
+  /// elements from K and M in the same order as the run did (so both are the same bit for bit) and let the
+  /// integrator update once. Energies are not booked again (they are part of the restored state).
+  void replayDeletions();
+  /// Take rod element e out of K and M (its lumped mass stays at its nodes).
+  void removeBeamFromMatrices(int e);
   /// Set q, v, a of the prescribed DOFs at time t.
   void applyBoundaryConditions(double t);
   /// Replace the state by the static elastic solution at applied displacement U (intact interfaces elastic,

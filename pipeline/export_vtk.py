@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""Export one enamel-dem result (result.h5) to ParaView files, one time point per written frame (/frames/<n>).
+
+Two series, both in the reference configuration (apply "Warp By Vector" with `displacement` to deform):
+  rods        line cells, one per rod (beam) element, between its two nodes.
+              cell data: broken (1 = deleted), strength_over_sigma0, stress_over_sigma0 (the solver's brittle
+              criterion recomputed from the frame's nodal displacements and rotations: axial N/A plus the larger
+              end bending stress, sigma0 units; NaN for deleted elements), stress_ratio (stress / strength: the
+              element is deleted when it reaches 1). point data: displacement (ux, uy, uz), rotation (rx, ry, rz).
+  interfaces  vertex cells at the interface midpoints (centre of the shared Voronoi edge).
+              cell data: damage (1 - secant stiffness / k), state (0 elastic, 1 inelastic, 2 failed), tag (0 ply 1,
+              1 ply 2, 2 interlayer 1-2, 3 interlayer 2-1), area (d^2). point data: displacement (mean of its
+              two nodes).
+Lengths in d, stresses in sigma0. Time value of each point: the frame's crack advance Delta_a/d (frames that
+repeat the state of the previous one, same solver step, are skipped); OUTDIR/frames.csv lists the frames.
+
+Formats: --format vtu (default): rods.pvd + rods_NNN.vtu, interfaces.pvd + interfaces_NNN.vtu;
+         --format xdmf: rods.xdmf/.h5 and interfaces.xdmf/.h5 written with meshio.xdmf.TimeSeriesWriter.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import sys
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "figures"))
+import common  # noqa: E402
+
+import meshio  # noqa: E402
+
+
+# --- rod stress: the solver's check (solver/lib/beam.cpp maxTensileStress), vectorised over elements ---
+def section_properties(name: str, d: float = 1.0) -> dict:
+    """Hexagon (across flats d): A = sqrt(3)/2 d^2, Iy = Iz = 5 sqrt(3)/144 d^4; circle: A = pi d^2/4,
+    Iy = Iz = pi d^4/64; extreme fibre c = d/2 for both (beam.hpp)."""
+    if name == "circle":
+        return dict(A=np.pi * d ** 2 / 4, I=np.pi * d ** 4 / 64, c=d / 2)
+    return dict(A=np.sqrt(3) / 2 * d ** 2, I=5 * np.sqrt(3) / 144 * d ** 4, c=d / 2)
+
+
+def local_frames(xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
+    """Rows e1 (a -> b), e2, e3 per element: e3 = normalize(z - (z.e1) e1), e2 = e3 x e1; parallel to z:
+    e2 = x, e3 = e1 x e2 (beam.cpp localFrame). Shape (n, 3, 3)."""
+    e1 = xb - xa
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    z = np.array([0.0, 0.0, 1.0])
+    zp = z[None, :] - e1[:, 2:3] * e1
+    nz = np.linalg.norm(zp, axis=1)
+    ok = nz > 1e-8
+    e3 = np.zeros_like(e1)
+    e2 = np.zeros_like(e1)
+    e3[ok] = zp[ok] / nz[ok, None]
+    e2[ok] = np.cross(e3[ok], e1[ok])
+    e2[~ok] = np.array([1.0, 0.0, 0.0])
+    e3[~ok] = np.cross(e1[~ok], e2[~ok])
+    return np.stack([e1, e2, e3], axis=1)
+
+
+def rod_stress(X: np.ndarray, beam_nodes: np.ndarray, q6: np.ndarray, section: dict, E: float = 1.0):
+    """Max tensile stress of each element (units of E_r) from nodal displacements/rotations q6 (nodes, 6):
+       sigma = N/A + max_end sqrt((My c/Iy)^2 + (Mz c/Iz)^2),  N = EA/L (u'_b - u'_a),
+       end moments from the Hermite bending stiffness EI/L^3 [12 6L -12 6L; 6L 4L^2 -6L 2L^2; ...] acting on
+       (v_a, theta_z,a, v_b, theta_z,b) in x'y' and on (w_a, -theta_y,a, w_b, -theta_y,b) in x'z' (local axes)."""
+    a, b = beam_nodes[:, 0], beam_nodes[:, 1]
+    xa, xb = X[a], X[b]
+    L = np.linalg.norm(xb - xa, axis=1)
+    R = local_frames(xa, xb)
+    loc = lambda v: np.einsum("nij,nj->ni", R, v)  # noqa: E731
+    ua, ra, ub, rb = loc(q6[a, :3]), loc(q6[a, 3:]), loc(q6[b, :3]), loc(q6[b, 3:])
+    A, I, c = section["A"], section["I"], section["c"]
+    N = E * A / L * (ub[:, 0] - ua[:, 0])
+    k = E * I / L ** 3
+
+    def end_moments(w0, t0, w1, t1):  # rows 2 and 4 of the Hermite block: moments at ends a and b
+        ma = k * (6 * L * w0 + 4 * L ** 2 * t0 - 6 * L * w1 + 2 * L ** 2 * t1)
+        mb = k * (6 * L * w0 + 2 * L ** 2 * t0 - 6 * L * w1 + 4 * L ** 2 * t1)
+        return ma, mb
+
+    mz_a, mz_b = end_moments(ua[:, 1], ra[:, 2], ub[:, 1], rb[:, 2])
+    my_a, my_b = end_moments(ua[:, 2], -ra[:, 1], ub[:, 2], -rb[:, 1])
+    bend = np.maximum(np.hypot(my_a, mz_a), np.hypot(my_b, mz_b)) * c / I
+    return N / A + bend
+
+
+# --- writing ---
+def distinct_frames(frames):
+    """Frames in order, without those that repeat the previous frame's solver step (the final-state frame
+    often repeats the last targeted one)."""
+    out = []
+    for f in sorted(frames, key=lambda f: (f.step, f.index)):
+        if out and out[-1].step == f.step:
+            continue
+        out.append(f)
+    return out
+
+
+def write_pvd(path: pathlib.Path, entries):
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">', "  <Collection>"]
+    for t, fname in entries:
+        lines.append(f'    <DataSet timestep="{t:.10g}" group="" part="0" file={quoteattr(fname)}/>')
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    path.write_text("\n".join(lines))
+
+
+def add_nodes_per_element(path: pathlib.Path) -> None:
+    """The XDMF format needs NodesPerElement on Polyline and Polyvertex topologies; meshio 5 leaves it out."""
+    text = path.read_text()
+    for kind, n in (("Polyline", 2), ("Polyvertex", 1)):
+        text = text.replace(f'TopologyType="{kind}" NumberOfElements=',
+                            f'TopologyType="{kind}" NodesPerElement="{n}" NumberOfElements=')
+    path.write_text(text)
+
+
+def export(result_path, outdir, fmt: str = "vtu") -> dict:
+    r = common.load_result(result_path, full=True)
+    g = r.geometry
+    outdir = pathlib.Path(outdir).resolve()
+    outdir.mkdir(parents=True, exist_ok=True)
+    sigma0 = float(r.meta["sigma0"])
+    section = section_properties(str(r.params.get("section", "hexagon")))
+    strength = np.where(np.isfinite(g.beam_strength), g.beam_strength, np.nan)
+    frames = distinct_frames(r.frames)
+    times = [f.da for f in frames]
+    if any(b <= a for a, b in zip(times, times[1:])):  # not strictly increasing: number the frames instead
+        times = [float(i) for i in range(len(frames))]
+    X = g.node_position.astype(np.float64)
+    rod_cells = [("line", g.beam_nodes.astype(np.int64))]
+    mid = g.iface_midpoint.astype(np.float64)
+    iface_cells = [("vertex", np.arange(len(mid), dtype=np.int64)[:, None])]
+    ia, ib = g.iface_nodes[:, 0], g.iface_nodes[:, 1]
+
+    def frame_data(f):
+        q = f.node_displacement.astype(np.float64)
+        stress = rod_stress(X, g.beam_nodes, q, section) / sigma0
+        broken = f.beam_broken.astype(np.uint8)
+        stress = np.where(broken > 0, np.nan, stress)
+        rods = dict(point_data={"displacement": q[:, :3], "rotation": q[:, 3:]},
+                    cell_data={"broken": [broken], "strength_over_sigma0": [strength],
+                               "stress_over_sigma0": [stress], "stress_ratio": [stress / strength]})
+        ifaces = dict(point_data={"displacement": 0.5 * (q[ia, :3] + q[ib, :3])},
+                      cell_data={"damage": [f.iface_damage.astype(np.float64)],
+                                 "state": [f.iface_state.astype(np.int32)],
+                                 "tag": [g.iface_tag.astype(np.int32)]})
+        return rods, ifaces
+
+    written = []
+    if fmt == "vtu":
+        rod_entries, iface_entries = [], []
+        for i, (f, t) in enumerate(zip(frames, times)):
+            rods, ifaces = frame_data(f)
+            rn, inn = f"rods_{i:03d}.vtu", f"interfaces_{i:03d}.vtu"
+            meshio.Mesh(X, rod_cells, **rods).write(outdir / rn)
+            meshio.Mesh(mid, iface_cells, **ifaces).write(outdir / inn)
+            rod_entries.append((t, rn))
+            iface_entries.append((t, inn))
+        write_pvd(outdir / "rods.pvd", rod_entries)
+        write_pvd(outdir / "interfaces.pvd", iface_entries)
+        written = [outdir / "rods.pvd", outdir / "interfaces.pvd"]
+    elif fmt == "xdmf":
+        data = [frame_data(f) for f in frames]
+        cwd = os.getcwd()
+        os.chdir(outdir)  # meshio 5 writes the .h5 beside the working directory, not beside the .xdmf
+        try:
+            for name, pts, cells, k in (("rods", X, rod_cells, 0), ("interfaces", mid, iface_cells, 1)):
+                with meshio.xdmf.TimeSeriesWriter(f"{name}.xdmf") as w:
+                    w.write_points_cells(pts, cells)
+                    for t, d in zip(times, data):
+                        w.write_data(t, point_data=d[k]["point_data"], cell_data=d[k]["cell_data"])
+                add_nodes_per_element(outdir / f"{name}.xdmf")
+                written.append(outdir / f"{name}.xdmf")
+        finally:
+            os.chdir(cwd)
+    else:
+        raise ValueError(f"unknown format '{fmt}'")
+    with open(outdir / "frames.csv", "w") as fcsv:
+        fcsv.write("index,time_value,target_da_over_d,da_over_d,step,frame_group\n")
+        for i, (f, t) in enumerate(zip(frames, times)):
+            fcsv.write(f"{i},{t:.10g},{f.target_da:g},{f.da:.10g},{f.step},/frames/{f.index}\n")
+    return dict(files=written, frames=len(frames), beams=len(g.beam_nodes), interfaces=len(mid))
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("result", type=pathlib.Path, metavar="RESULT_H5", help="a result.h5 written by enamel-dem")
+    p.add_argument("outdir", type=pathlib.Path, metavar="OUTDIR", help="output directory (created)")
+    p.add_argument("--format", choices=("vtu", "xdmf"), default="vtu",
+                   help="vtu: .pvd + .vtu series (default); xdmf: XDMF time series (meshio TimeSeriesWriter)")
+    args = p.parse_args(argv)
+    try:
+        info = export(args.result, args.outdir, args.format)
+    except common.MissingResult as e:
+        print(f"export_vtk.py: missing result file {e.path}: run the case first "
+              f"(`enamel-dem run CASE.toml` or `make runs PRESET=...`)", file=sys.stderr)
+        return common.EXIT_MISSING
+    for fpath in info["files"]:
+        print(fpath)
+    print(f"{info['frames']} frames, {info['beams']} rod elements, {info['interfaces']} interfaces",
+          file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

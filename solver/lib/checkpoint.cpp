@@ -1,0 +1,150 @@
+#include "checkpoint.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <type_traits>
+
+namespace enamel {
+
+namespace {
+
+constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
+constexpr std::uint32_t kVersion = 1;
+
+struct Writer {
+  std::ofstream out;
+  template <class T>
+  void pod(const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    out.write(reinterpret_cast<const char*>(&x), sizeof x);
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod(static_cast<std::uint64_t>(v.size()));
+    if (!v.empty()) out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+  }
+  void vec(const VecX& v) { vec(std::vector<double>(v.data(), v.data() + v.size())); }
+  void str(const std::string& s) { vec(std::vector<char>(s.begin(), s.end())); }
+};
+
+struct Reader {
+  std::ifstream in;
+  std::string path;
+  template <class T>
+  void pod(T& x) {
+    in.read(reinterpret_cast<char*>(&x), sizeof x);
+    if (!in) throw CheckpointError("checkpoint '" + path + "' is truncated");
+  }
+  template <class T>
+  void vec(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    pod(n);
+    if (n > (1ULL << 34)) throw CheckpointError("checkpoint '" + path + "' is corrupt (vector of " + std::to_string(n) + ")");
+    v.resize(n);
+    if (n) in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
+    if (!in) throw CheckpointError("checkpoint '" + path + "' is truncated");
+  }
+  void vec(VecX& v, Eigen::Index expected) {
+    std::vector<double> tmp;
+    vec(tmp);
+    if (static_cast<Eigen::Index>(tmp.size()) != expected)
+      throw CheckpointError("checkpoint '" + path + "' does not fit this model (" + std::to_string(tmp.size()) +
+                            " values for " + std::to_string(expected) + ")");
+    v = Eigen::Map<VecX>(tmp.data(), expected);
+  }
+  void str(std::string& s) {
+    std::vector<char> tmp;
+    vec(tmp);
+    s.assign(tmp.begin(), tmp.end());
+  }
+};
+
+}  // namespace
+
+void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec) {
+  const std::string tmp = path + ".tmp";
+  {
+    Writer w{std::ofstream(tmp, std::ios::binary | std::ios::trunc)};
+    if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "'");
+    w.out.write(kMagic, sizeof kMagic);
+    w.pod(kVersion);
+    w.str(sim.params.tomlText);
+    const State& s = sim.state;
+    w.pod(s.step); w.pod(s.time); w.pod(s.appliedDisplacement);
+    w.vec(s.q); w.vec(s.v); w.vec(s.a);
+    w.vec(s.lambdaMax); w.vec(s.beamBroken); w.vec(s.deletionOrder);
+    w.pod(s.externalWork); w.pod(s.dampingWork); w.pod(s.rodFractureEnergy); w.pod(s.lastExternalPower);
+    w.pod(s.brokenBeams); w.pod(s.failedInterfaces); w.pod(s.crackAdvance);
+    w.vec(sim.reaction);
+    w.vec(rec.history);  // Measurement is plain data
+    w.vec(rec.rcurveDa); w.vec(rec.rcurveJ);
+    w.pod(static_cast<std::uint64_t>(rec.frames.size()));
+    for (const Frame& f : rec.frames) {
+      w.pod(f.targetDa); w.pod(f.da); w.pod(f.step); w.pod(f.time); w.pod(f.appliedDisplacement);
+      w.vec(f.nodeDisplacement); w.vec(f.ifaceDamage); w.vec(f.ifaceState); w.vec(f.beamBroken);
+    }
+    w.str(rec.status); w.str(rec.stopReason);
+    w.pod(rec.wallSeconds); w.pod(rec.steps); w.pod(rec.maxKineticRatio);
+    w.pod(rec.warnedBalance); w.pod(rec.warnedKinetic);
+    w.pod(static_cast<std::uint64_t>(rec.warnings.size()));
+    for (const auto& s2 : rec.warnings) w.str(s2);
+    w.out.write(kMagic, sizeof kMagic);  // trailer: a complete file ends with the magic again
+    w.out.flush();
+    if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "' (disk full?)");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw CheckpointError("cannot rename '" + tmp + "' to '" + path + "'");
+}
+
+void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
+  Reader r{std::ifstream(path, std::ios::binary), path};
+  if (!r.in) throw CheckpointError("no checkpoint '" + path + "' to restart from");
+  char magic[8];
+  r.in.read(magic, sizeof magic);
+  if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw CheckpointError("'" + path + "' is not an enamel-dem checkpoint");
+  std::uint32_t version = 0;
+  r.pod(version);
+  if (version != kVersion)
+    throw CheckpointError("checkpoint '" + path + "' has format version " + std::to_string(version) +
+                          ", this build reads version " + std::to_string(kVersion));
+  std::string toml;
+  r.str(toml);
+  if (toml != sim.params.tomlText)
+    throw CheckpointError("checkpoint '" + path + "' was written for a different case (effective keys differ): "
+                          "restart with the same case file, --preset and --set options");
+  State& s = sim.state;
+  const Eigen::Index n = sim.model.numDofs();
+  r.pod(s.step); r.pod(s.time); r.pod(s.appliedDisplacement);
+  r.vec(s.q, n); r.vec(s.v, n); r.vec(s.a, n);
+  r.vec(s.lambdaMax); r.vec(s.beamBroken); r.vec(s.deletionOrder);
+  if (s.lambdaMax.size() != static_cast<std::size_t>(sim.model.numInterfaces()) ||
+      s.beamBroken.size() != static_cast<std::size_t>(sim.model.numBeams()))
+    throw CheckpointError("checkpoint '" + path + "' does not fit this model");
+  r.pod(s.externalWork); r.pod(s.dampingWork); r.pod(s.rodFractureEnergy); r.pod(s.lastExternalPower);
+  r.pod(s.brokenBeams); r.pod(s.failedInterfaces); r.pod(s.crackAdvance);
+  r.vec(sim.reaction, static_cast<Eigen::Index>(sim.prescribedDofs.size()));
+  r.vec(rec.history);
+  r.vec(rec.rcurveDa); r.vec(rec.rcurveJ);
+  std::uint64_t nf = 0;
+  r.pod(nf);
+  rec.frames.resize(nf);
+  for (Frame& f : rec.frames) {
+    r.pod(f.targetDa); r.pod(f.da); r.pod(f.step); r.pod(f.time); r.pod(f.appliedDisplacement);
+    r.vec(f.nodeDisplacement); r.vec(f.ifaceDamage); r.vec(f.ifaceState); r.vec(f.beamBroken);
+  }
+  r.str(rec.status); r.str(rec.stopReason);
+  r.pod(rec.wallSeconds); r.pod(rec.steps); r.pod(rec.maxKineticRatio);
+  r.pod(rec.warnedBalance); r.pod(rec.warnedKinetic);
+  std::uint64_t nw = 0;
+  r.pod(nw);
+  rec.warnings.resize(nw);
+  for (auto& w : rec.warnings) r.str(w);
+  r.in.read(magic, sizeof magic);
+  if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw CheckpointError("checkpoint '" + path + "' is truncated");
+  sim.replayDeletions();
+}
+
+}  // namespace enamel
