@@ -575,9 +575,13 @@ toml::table parseSet(const std::string& set) {
         if (parsed.size() == 1 && parsed.contains(key)) return parsed;
     } catch (const toml::parse_error&) {
     }
-    toml::table t;
-    t.insert(key, value);
-    return t;
+    // Taken as a string: it must still be text that TOML can hold (valid UTF-8), or the effective case
+    // (tomlText) would not read back. quote() escapes the control characters.
+    try {
+        return toml::parse(quote(key) + " = " + quote(value) + "\n");
+    } catch (const toml::parse_error&) {
+        throw CaseError(exit_code::usage, "--set '" + set + "': not valid UTF-8 text");
+    }
 }
 
 void checkCrossKeys(const CaseParams& p, const std::string& src) {
@@ -596,9 +600,17 @@ void checkCrossKeys(const CaseParams& p, const std::string& src) {
 
 // The effective case as flat TOML, every key, in table order.
 std::string writeToml(const CaseParams& p, const std::vector<std::string>& sets) {
+    // Text for a '#' comment line: TOML comments hold no control characters but tab, and only valid
+    // UTF-8 (a file name need not be); anything else would make tomlText unreadable.
     auto oneLine = [](std::string s) {
-        std::replace(s.begin(), s.end(), '\n', ' ');
-        std::replace(s.begin(), s.end(), '\r', ' ');
+        for (char& c : s)
+            if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f) c = ' ';
+        try {
+            static_cast<void>(toml::parse("#" + s));  // throws on text a comment cannot hold
+        } catch (const toml::parse_error&) {
+            for (char& c : s)
+                if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+        }
         return s;
     };
     std::string out = "# enamel-dem effective case (key defaults < preset < case file < --set)\n";

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <sstream>
 
@@ -68,6 +69,10 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     rec.stopReason = why;
   };
 
+  // Fault injection for the tests of the failure path: ENAMEL_INJECT_NAN_AT_STEP=N puts a NaN into one free
+  // displacement after step N, as a diverging run would (tests/python/test_cli.py).
+  const char* injectEnv = std::getenv("ENAMEL_INJECT_NAN_AT_STEP");
+  const long injectAt = injectEnv ? std::atol(injectEnv) : -1;
   if (opt.restart) {
     readCheckpoint(opt.checkpointPath, sim, rec);
     rec.status = "running";
@@ -81,6 +86,7 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
   save();
   while (true) {
     sim.step();
+    if (sim.state.step == injectAt) sim.state.q[sim.freeDofs[sim.freeDofs.size() / 2]] = NAN;
     const State& s = sim.state;
     // R-curve point each time the crack advanced.
     if (s.crackAdvance > lastDa) {

@@ -1,5 +1,9 @@
 """Command line: --help on every command, and bad input answered by one clear line and a distinct exit
 status before anything is allocated or written (issues "Foundation" and "Hard cases and faults")."""
+import os
+import subprocess
+
+import h5py
 import pytest
 
 from conftest import CASES
@@ -93,3 +97,28 @@ def test_info_prints_counts(run):
     # hand count of the 6 d x 4 d specimen at h_e = 0.3 d (tests/cpp/test_geometry.cpp)
     assert "168" in r.stdout and "160" in r.stdout
     assert "bending governs" in r.stdout
+
+
+def test_time_step_above_stable_limit_is_refused(run, tmp_path):
+    """dt_factor 0.5 with the paper scheme is above 0.95 x 2/omega_max: refused with the limit, nothing written."""
+    out = tmp_path / "out"
+    r = run("run", CASES / "small_theta0.toml", "--out", out, "--set", "dt_factor=0.5", "--set", 'integrator="paper"')
+    assert r.returncode == OUT_OF_RANGE, r.stderr
+    line = r.stderr.strip()
+    assert len(line.splitlines()) == 1 and "stable limit" in line and "dt_factor <=" in line, line
+    assert not (out / "result.h5").exists()
+
+
+def test_diverging_run_stops_with_readable_failed_result(enamel, tmp_path):
+    """A NaN in the state (injected after step 200, as a diverging run would produce) stops the run at the next
+    check with a message naming the quantity and the step; the partial result.h5 is readable and marked failed."""
+    out = tmp_path / "out"
+    env = dict(os.environ, ENAMEL_INJECT_NAN_AT_STEP="200")
+    r = subprocess.run([str(enamel), "run", str(CASES / "small_theta0.toml"), "--out", str(out), "--quiet"],
+                       capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 10, r.stderr
+    assert "non-finite" in r.stderr and "step" in r.stderr
+    with h5py.File(out / "result.h5", "r") as f:
+        assert f["meta"].attrs["status"] == "failed"
+        assert "non-finite" in f["meta"].attrs["stop_reason"]
+        assert f["history/step"][-1] >= 200
