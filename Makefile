@@ -121,7 +121,8 @@ FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
 	$(PYTHON) $< --preset $(PRESET)
 
-figures: check-preset build $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
+figures: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
+	@test -n "$(FIGURES)" || { echo "figures: no figure list ($(BUILD_DIR)/figures.mk could not be made with PYTHON=$(PYTHON)); run 'make deps' first" >&2; exit 1; }
 	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
 
 # ParaView: one .pvd + .vtu time series per finished run (rods and interfaces), in runs/<preset>/<case>/vtk/.
