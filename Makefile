@@ -10,6 +10,9 @@
 #   make vtk      [PRESET=...]  ParaView files (.pvd + .vtu series) of every finished run, in runs/<preset>/<case>/vtk/
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
+#
+#   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
+#   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 
 SHELL := /bin/bash
 BUILD_DIR ?= build
@@ -137,3 +140,6 @@ reference: build
 
 clean-runs: check-preset
 	rm -rf $(RUNS)/$(PRESET) $(FIG_OUT)
+
+# Sanitizer and fuzz targets.
+include tests/fuzz/quality.mk

@@ -46,7 +46,7 @@ double effectiveSeparation(const Vec3& openingLocal) {
 
 // S = T(lambdaMax)/lambdaMax, with S = k on the elastic branch (also at lambdaMax = 0) and S = 0 once failed.
 double secantStiffness(const Law& law, double lambdaMax) {
-  if (lambdaMax <= law.delta0()) return law.k;
+  if (law.k * lambdaMax <= law.sigma0) return law.k;  // lambdaMax <= delta0, without a division (hot path)
   if (lambdaMax >= law.deltaf()) return 0.0;
   return envelopeTraction(law, lambdaMax) / lambdaMax;
 }

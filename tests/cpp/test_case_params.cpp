@@ -409,3 +409,23 @@ TEST(CaseParams, SmallTestCasesLoad) {
         EXPECT_LT(p.stop_da_over_d, p.w_s_over_d - p.a0());
     }
 }
+
+// Fuzz findings (tests/fuzz/regressions/set-*.toml): the effective case must always read back. A --set value
+// that is not valid UTF-8 is refused as a usage error; control characters in a --set are escaped, so that
+// parseCase(tomlText) gives the same case again.
+TEST(CaseParams, SetValuesThatTomlCannotHoldAreRefusedOrEscaped) {
+    const std::string base = "theta_D = 0\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n";
+    try {
+        enamel::parseCase(base, "case", "", {"description=caf\xe9"});
+        FAIL() << "invalid UTF-8 in --set was accepted";
+    } catch (const CaseError& e) {
+        EXPECT_EQ(e.exitCode, enamel::exit_code::usage);
+        EXPECT_NE(std::string(e.what()).find("UTF-8"), std::string::npos) << e.what();
+    }
+    const enamel::CaseParams p = enamel::parseCase(base, "case", "", {"description=a\x01" "b"});
+    EXPECT_EQ(p.description, "a\x01" "b");
+    const enamel::CaseParams again = enamel::parseCase(p.tomlText, "again", "", {});
+    EXPECT_EQ(again.description, p.description);
+    auto keysPart = [](const std::string& t) { return t.substr(t.find("# --- physics")); };  // comments differ
+    EXPECT_EQ(keysPart(again.tomlText), keysPart(p.tomlText));
+}
