@@ -11,6 +11,8 @@
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
+#   make bench         speed against error of every integrator and knob, and cost growth, in one run (~1.5 h on
+#                      2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 
@@ -37,7 +39,7 @@ PRESETS := ci reduced paper
 RUNS := runs
 FIG_OUT := figures/out/$(PRESET)
 
-.PHONY: help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
+.PHONY: bench help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -72,6 +74,9 @@ test-python:
 
 clean:
 	rm -rf $(BUILD_DIR)
+
+bench: $(ENAMEL)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) bench/run_bench.py --jobs $(JOBS)
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.

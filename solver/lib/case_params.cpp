@@ -86,6 +86,10 @@ const std::vector<KeySpec>& caseKeys() {
         {"integrator", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "paper|lumped", "paper", "-",
          "integrator: paper = Newmark beta 0, consistent mass, H = M + dt/2 C factorised (reference); "
          "lumped = explicit, lumped mass"},
+        {"damping_cap", Kind::Real, "numerics", false, 1, 0, 2, O, C, "", "", "-",
+         "stiffness damping cap (integrator lumped): b' = min(b, damping_cap / omega_max), i.e. the "
+         "stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "
+         "the stable step"},
         {"linear_solver", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "cholmod|umfpack", "cholmod",
          "-", "linear solver: for H = M + dt/2 C (integrator paper): CHOLMOD Cholesky or UMFPACK LU"},
         {"deletion_rule", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "most_overloaded|all",
@@ -181,6 +185,7 @@ const std::vector<Binding>& bindings() {
         {"zeta", &P::zeta},
         {"dt_factor", &P::dt_factor},
         {"integrator", &P::integrator},
+        {"damping_cap", &P::damping_cap},
         {"linear_solver", &P::linear_solver},
         {"deletion_rule", &P::deletion_rule},
         {"stop_da_over_d", &P::stop_da_over_d},

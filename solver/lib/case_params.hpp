@@ -66,6 +66,7 @@ struct CaseParams {
     double ramp_transits = 0;          // velocity ramp duration / (h_s/c_d)
     double zeta = 0;                   // Rayleigh damping ratio at w_min = pi c_d / h_s
     double dt_factor = 0;              // dt / smallest element period (integrator "paper")
+    double damping_cap = 1;            // lumped: b' omega_max at most this
     std::string integrator;            // "paper" | "lumped"
     std::string linear_solver;         // "cholmod" | "umfpack"
     std::string deletion_rule;         // "most_overloaded" | "all"

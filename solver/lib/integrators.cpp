@@ -225,8 +225,9 @@ void multiplyTwo(const SpMatRow& K, const VecX& x1, const VecX& x2, VecX& y1, Ve
 // Fast scheme `lumped` (ours, DESIGN section 4): explicit central differences with a diagonal mass.
 //   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
 //      alpha rho Ip L / 2 per element end, alpha the smallest scale at which rotations stop governing.
-//   C = a M + b' K with b' = min(b, 1/omega_max) (the stiffness part capped so that its damping ratio at
-//      omega_max is at most 1/2; an explicit stiffness damping above that would need a far smaller step).
+//   C = a M + b' K with b' = min(b, c/omega_max), c = damping_cap (default 1: the stiffness part's damping
+//      ratio at omega_max is at most 1/2; an explicit stiffness damping above that would need a far smaller
+//      step, and a lower cap allows a larger one).
 //   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface(q_n) - b' K v_{n-1/2})] / (1 + a dt/2)
 //   q_{n+1}   = q_n + dt v_{n+1/2}
 //   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
@@ -253,7 +254,7 @@ class LumpedIntegrator : public Integrator {
     invMass_ = mass_.cwiseInverse();
     sim.addedRotaryInertia = rotaryScale_ - 1.0;
     omegaMax_ = estimateOmegaMax(sim, invMass_);
-    bEff_ = std::min(sim.dampB, 1.0 / omegaMax_);
+    bEff_ = std::min(sim.dampB, sim.params.damping_cap / omegaMax_);
     dt_ = sim.params.dt_factor * 2.0 * M_PI / omegaMax_;
     const double xi = 0.5 * bEff_ * omegaMax_ + 0.5 * sim.dampA / omegaMax_;
     const double limit = 2.0 / omegaMax_ * (std::sqrt(1.0 + xi * xi) - xi);

@@ -60,6 +60,19 @@ RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<d
 
 namespace {
 
+// Peak resident memory of this process (VmHWM of /proc/self/status) in MB; NaN where there is no /proc.
+double peakMemoryMB() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return NAN;
+  char line[256];
+  double kb = NAN;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "VmHWM: %lf kB", &kb) == 1) break;
+  std::fclose(f);
+  return kb / 1024.0;
+}
+
+
 // --- a thin RAII layer over the HDF5 C API ---
 struct Handle {
   hid_t id;
@@ -171,6 +184,9 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "wall_time_s", rec.wallSeconds);
       attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
       attr(g.id, "steps", rec.steps);
+      attr(g.id, "dof", static_cast<long>(sim.model.numDofs()));
+      attr(g.id, "threads", static_cast<long>(threadCount()));
+      attr(g.id, "peak_memory_mb", peakMemoryMB());
       attr(g.id, "written_utc", utcNow());
       attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "
                           "(time in d/c_r, c_r = sqrt(E_r/rho_r))");

@@ -63,6 +63,9 @@ struct Measurement {
 
 class Simulation;
 
+/// Worker threads the force loops use (set from the case key `threads` when a Simulation is built).
+int threadCount();
+
 /// A time integrator: advances the state by one step. The paper scheme is the reference; others sit beside it.
 class Integrator {
  public:

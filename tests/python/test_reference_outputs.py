@@ -10,16 +10,13 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "reference"))
-import make_reference  # noqa: E402
+import make_reference  # noqa: E402  (puts figures/ on the path)
+import common  # noqa: E402
 
 
 def rcurve_difference(ref, new):
     """Relative L2 difference of two R-curves over their common Delta_a range (50 points)."""
-    da1, R1 = np.asarray(ref["da_over_d"]), np.asarray(ref["R_over_Gamma"])
-    da2, R2 = np.asarray(new["da_over_d"]), np.asarray(new["R_over_Gamma"])
-    grid = np.linspace(max(da1[0], da2[0]), min(da1[-1], da2[-1]), 50)
-    a, b = np.interp(grid, da1, R1), np.interp(grid, da2, R2)
-    return float(np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(a ** 2)))
+    return common.rcurve_rel_l2(ref["da_over_d"], ref["R_over_Gamma"], new["da_over_d"], new["R_over_Gamma"])
 
 
 def compare(ref, new):

@@ -1,0 +1,486 @@
+#!/usr/bin/env python3
+"""`make bench`: speed against error of the integrators and their knobs, and how the cost grows.
+
+Everything is measured in ONE run of this script, so that every ratio compares runs made on the same
+machine in the same state:
+
+1. Speed against error. Each bench case runs at the `reduced` preset with the reference scheme (`paper` at
+   the preset's loading rate, the slowest rate measured here) and with every fast variant (integrator and
+   knobs: time-step factor, stiffness-damping cap, loading rate, threads). For each run: wall time (the whole
+   process, set-up included), CPU time, steps, DOF, DOF-updates per second per core, peak memory, and the
+   error against the reference of the same case: R-curve relative L2 difference over the common Delta_a
+   range, R_init and R_ss differences, broken rod elements. The runs share the cores two at a time
+   (--jobs), the long reference runs first.
+2. Cost growth. Short runs (a fixed number of steps) of the theta_D = 30 case at growing specimen size and
+   finer slice spacing h_e, both integrators: wall time per step against DOF and h_e, and from it an estimate
+   of the wall time of one whole run, up to the `paper` preset (200 d x 200 d).
+
+Writes bench/results.csv, bench/cost_growth.csv, bench/results.md (the README quotes them) and
+bench/out/pareto.{pdf,png}, bench/out/cost_growth.{pdf,png}. Runs go to runs/bench/.
+"""
+import argparse
+import csv
+import dataclasses
+import datetime
+import math
+import os
+import pathlib
+import platform
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "figures"))
+import common  # noqa: E402
+import paths  # noqa: E402
+
+import matplotlib  # noqa: E402
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ERROR_BOUND = 0.02   # R-curve relative L2 difference from the reference: "within the error bound"
+PRESET = "reduced"
+CASES = ["theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1"]
+REFERENCE = "paper"
+
+# Variants: name -> (--set overrides, threads). `paper` is the reference. dt_factor is dt over the smallest
+# period of the integrator's own system (lumped: stable up to ~0.187 with damping_cap 1, ~0.236 with 0.5).
+VARIANTS = {
+    "paper": ({"integrator": '"paper"'}, 1),
+    "lumped": ({"integrator": '"lumped"'}, 1),
+    "lumped dt0.15": ({"integrator": '"lumped"', "dt_factor": 0.15}, 1),
+    "lumped dt0.18": ({"integrator": '"lumped"', "dt_factor": 0.18}, 1),
+    "lumped cap0.5 dt0.22": ({"integrator": '"lumped"', "damping_cap": 0.5, "dt_factor": 0.22}, 1),
+    "lumped rate2": ({"integrator": '"lumped"', "rate_factor": 2}, 1),
+    "lumped rate4": ({"integrator": '"lumped"', "rate_factor": 4}, 1),
+    "lumped dt0.18 rate2": ({"integrator": '"lumped"', "dt_factor": 0.18, "rate_factor": 2}, 1),
+    "lumped dt0.18 rate4": ({"integrator": '"lumped"', "dt_factor": 0.18, "rate_factor": 4}, 1),
+    "lumped cap0.5 dt0.22 rate2": ({"integrator": '"lumped"', "damping_cap": 0.5, "dt_factor": 0.22,
+                                    "rate_factor": 2}, 1),
+    "lumped cap0.5 dt0.22 rate4": ({"integrator": '"lumped"', "damping_cap": 0.5, "dt_factor": 0.22,
+                                    "rate_factor": 4}, 1),
+    "lumped 2 threads": ({"integrator": '"lumped"'}, 2),
+}
+TWO_THREAD_CASES = CASES[:1]   # the 2-thread variant runs on the first case only (it needs both cores)
+
+# Cost growth: (w_s, h_s, h_e) at the base case; steps per run are chosen so each takes ~10-20 s.
+COST_CASE = CASES[0]
+COST_SIZES = [(16, 8, 0.3), (24, 12, 0.3), (40, 20, 0.3), (80, 40, 0.3), (200, 200, 0.3),
+              (40, 20, 0.2), (40, 20, 0.15)]
+COST_PAPER_MAX_DOF = 150_000   # the paper scheme's factorisation beyond this is left out (memory, minutes)
+COST_WORK = {"lumped": 3e8, "paper": 6e7}   # DOF x steps per cost run
+
+
+@dataclasses.dataclass
+class Job:
+    key: str                 # unique name (directory under runs/bench/)
+    args: list
+    cores: int
+    out: pathlib.Path
+    expected_s: float = 0.0  # for ordering: longest first
+    wall_s: float = math.nan
+    cpu_s: float = math.nan
+    maxrss_mb: float = math.nan
+    returncode: int = -1
+
+
+def solver() -> pathlib.Path:
+    return pathlib.Path(os.environ.get("ENAMEL_BINARY", paths.SOLVER))
+
+
+def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path) -> list:
+    a = [str(solver()), "run", str(case_file), "--preset", preset, "--out", str(out), "--force", "--quiet"]
+    for k, v in {**sets, "threads": threads}.items():
+        a += ["--set", f"{k}={v}"]
+    return a
+
+
+def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
+    """Run the jobs, longest first, never using more than `cores` cores; records wall, CPU and peak memory of
+    each (os.wait4 gives the child's own rusage)."""
+    pending = sorted(jobs, key=lambda j: -j.expected_s)
+    running = {}   # pid -> (job, start, popen)
+    free = cores
+    t_all = time.perf_counter()
+    while pending or running:
+        started = True
+        while started:
+            started = False
+            for j in pending:
+                if j.cores <= free or (not running and j.cores > cores):
+                    j.out.mkdir(parents=True, exist_ok=True)
+                    logf = open(j.out / "bench.log", "w")
+                    p = subprocess.Popen(j.args, stdout=logf, stderr=subprocess.STDOUT)
+                    logf.close()
+                    running[p.pid] = (j, time.perf_counter(), p)
+                    free -= j.cores
+                    pending.remove(j)
+                    started = True
+                    break
+        pid, status, ru = os.wait4(-1, 0)
+        if pid not in running:
+            continue
+        j, t0, p = running.pop(pid)
+        p.returncode = os.waitstatus_to_exitcode(status)
+        j.returncode = p.returncode
+        j.wall_s = time.perf_counter() - t0
+        j.cpu_s = ru.ru_utime + ru.ru_stime
+        j.maxrss_mb = ru.ru_maxrss / 1024.0
+        free += j.cores
+        log(f"[{time.perf_counter() - t_all:7.0f} s] {j.key}: exit {j.returncode}, {j.wall_s:.1f} s wall, "
+            f"{j.cpu_s:.1f} s CPU, {j.maxrss_mb:.0f} MB")
+
+
+def meta_of(result_h5) -> dict:
+    import h5py
+    with h5py.File(result_h5, "r") as f:
+        m = common._attrs(f["meta"])
+        h = f["history"]
+        m["U_end"] = float(h["applied_displacement"][-1])
+        m["t_end"] = float(h["time"][-1])
+        m["balance_end"] = float(h["energy_balance_error"][-1])
+    return m
+
+
+# ------------------------------------------------------------------------------------------- speed vs error
+def speed_error_jobs(cases, variants, preset, runs: pathlib.Path, extra_sets: dict) -> list[Job]:
+    jobs = []
+    for case in cases:
+        for name, (sets, threads) in variants.items():
+            if threads > 1 and case not in TWO_THREAD_CASES:
+                continue
+            out = runs / case / name.replace(" ", "_")
+            expected = 100.0 if name == REFERENCE else 1.0 / threads
+            jobs.append(Job(key=f"{case} / {name}", cores=threads, out=out, expected_s=expected,
+                            args=run_args(paths.case_file(case), preset, {**sets, **extra_sets}, threads, out)))
+    return jobs
+
+
+def speed_error_rows(jobs: list[Job]) -> list[dict]:
+    by_key = {j.key: j for j in jobs}
+    rows = []
+    for j in jobs:
+        case, name = j.key.split(" / ")
+        ref_job = by_key[f"{case} / {REFERENCE}"]
+        row = dict(case=case, variant=name, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s,
+                   peak_memory_mb=j.maxrss_mb)
+        try:
+            r = common.load_result(j.out / "result.h5", case=case)
+            ref = common.load_result(ref_job.out / "result.h5", case=case)
+            m = meta_of(j.out / "result.h5")
+        except (common.MissingResult, OSError, KeyError) as e:
+            row.update(status=f"no result ({e})")
+            rows.append(row)
+            continue
+        threads = int(m.get("threads", 1))
+        row["peak_memory_mb"] = m.get("peak_memory_mb", j.maxrss_mb)
+        row.update(
+            status=r.status, integrator=m["integrator"], threads=threads, dt=m["dt"], steps=int(m["steps"]),
+            dof=int(m["dof"]), stepping_s=m["wall_time_s"],
+            dof_updates_per_s_per_core=m["dof"] * m["steps"] / m["wall_time_s"] / threads,
+            dt_factor=r.param("dt_factor"), damping_cap=r.param("damping_cap"),
+            rate_factor=r.param("rate_factor"), added_rotary_inertia=m["added_rotary_inertia"],
+            speedup_wall=ref_job.wall_s / j.wall_s, speedup_cpu=ref_job.cpu_s / j.cpu_s,
+            rcurve_rel_l2=(common.rcurve_rel_l2(ref.da, ref.R, r.da, r.R)
+                           if r.da.size > 1 and ref.da.size > 1 else math.nan),
+            R_init=r.R_init, R_ss=r.R_ss, R_init_rel_diff=r.R_init / ref.R_init - 1,
+            R_ss_rel_diff=r.R_ss / ref.R_ss - 1, da_max=r.da_max,
+            broken_rods=r.broken_rods, broken_rods_diff=r.broken_rods - ref.broken_rods,
+            max_kinetic_over_strain=m["max_kinetic_over_strain_while_growing"],
+            energy_balance_end=m["balance_end"], warnings=" | ".join(str(m.get("warnings", "")).split("\n")[:-1]),
+            U_end=m["U_end"], t_end=m["t_end"], v_app=m["v_app"])
+        rows.append(row)
+    return rows
+
+
+# ------------------------------------------------------------------------------------------------- cost
+def cost_jobs(runs: pathlib.Path, sizes, integrators, extra_sets: dict) -> list[Job]:
+    jobs = []
+    for w, h, he in sizes:
+        dof_est = 27840 * (w * h) / 800.0 * 0.3 / he   # DOF ~ w h / h_e (27 840 at 40 x 20 d, h_e 0.3 d)
+        for integ in integrators:
+            if integ == "paper" and dof_est > COST_PAPER_MAX_DOF:
+                continue
+            steps = int(min(20000, max(50 if integ == "paper" else 100, COST_WORK[integ] / dof_est)))
+            out = runs / "cost" / f"{integ}_w{w}_h{h}_he{he}"
+            sets = {"integrator": f'"{integ}"', "w_s_over_d": w, "h_s_over_d": h, "h_e_over_d": he,
+                    "max_steps": steps, **extra_sets}
+            jobs.append(Job(key=f"cost / {integ} {w}x{h} h_e {he}", cores=1, out=out, expected_s=dof_est * 1e-9,
+                            args=run_args(paths.case_file(COST_CASE), PRESET, sets, 1, out)))
+    return jobs
+
+
+def cost_rows(jobs: list[Job], run_model: dict) -> list[dict]:
+    """Per step and per run. A whole run's steps are estimated as T_run / dt with T_run = ramp + U_end / v_app
+    and U_end = U_end(reference run) x sqrt(h_s / h_s(reference)) (the initiation displacement grows as
+    sqrt(h_s) for this grip loading); this leaves out that the paper preset's crack goes 30 d, not 12 d."""
+    rows = []
+    for j in jobs:
+        _, rest = j.key.split(" / ")
+        integ = rest.split()[0]
+        row = dict(integrator=integ, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s,
+                   peak_memory_mb=j.maxrss_mb)
+        try:
+            m = meta_of(j.out / "result.h5")
+        except OSError as e:
+            row.update(status=f"no result ({e})")
+            rows.append(row)
+            continue
+        r = common.load_result(j.out / "result.h5")
+        w, h, he, rate = (r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "v_app_over_cd"))
+        per_step = m["wall_time_s"] / m["steps"]
+        row["peak_memory_mb"] = m.get("peak_memory_mb", j.maxrss_mb)
+        row.update(status=m["status"], w_s=w, h_s=h, h_e=he, dof=int(m["dof"]), steps=int(m["steps"]),
+                   dt=m["dt"], setup_s=j.wall_s - m["wall_time_s"], s_per_step=per_step,
+                   dof_updates_per_s=m["dof"] / per_step)
+        if run_model:
+            c_d = m["c_d_over_cr"]
+            U_end = run_model["U_end"] * math.sqrt(h / run_model["h_s"])
+            for suffix, v in (("", run_model["v_app_over_cd"]), ("_at_1e-3", 1e-3)):
+                T = r.param("ramp_transits") * h / c_d + U_end / (v * c_d)
+                row[f"est_steps_per_run{suffix}"] = T / m["dt"]
+                row[f"est_run_s{suffix}"] = row["setup_s"] + per_step * T / m["dt"]
+        rows.append(row)
+    return rows
+
+
+# ---------------------------------------------------------------------------------------------- outputs
+def write_csv(rows: list[dict], path: pathlib.Path) -> None:
+    keys = []
+    for r in rows:
+        keys += [k for k in r if k not in keys]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    print(path)
+
+
+def within_bound(row) -> bool:
+    return row.get("status") == "completed" and row.get("rcurve_rel_l2", math.inf) <= ERROR_BOUND
+
+
+def pareto_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)
+    for ax, speed_key, xlabel in ((axes[0], "speedup_wall", "speed-up over `paper` (wall time, same run)"),
+                                  (axes[1], "dof_updates_per_s_per_core", "DOF-updates per second per core")):
+        for case, marker in zip(dict.fromkeys(r["case"] for r in rows), "os^D"):
+            pts = [r for r in rows if r["case"] == case and "rcurve_rel_l2" in r]
+            xs = np.array([r[speed_key] for r in pts])
+            ys = np.array([max(r["rcurve_rel_l2"], 1e-4) * 100 for r in pts])
+            ax.scatter(xs, ys, marker=marker, label=case, zorder=3)
+            for r, x, y in zip(pts, xs, ys):
+                ax.annotate(r["variant"], (x, y), fontsize=6.5, xytext=(3, 3), textcoords="offset points")
+            # Pareto front: no other point both faster and more accurate
+            order = np.argsort(-xs)
+            front, best = [], math.inf
+            for i in order:
+                if ys[i] < best:
+                    front.append(i)
+                    best = ys[i]
+            ax.plot(xs[front], ys[front], lw=0.8, alpha=0.6)
+        ax.axhline(ERROR_BOUND * 100, color="k", ls="--", lw=0.8, label=f"error bound {ERROR_BOUND:.0%}")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("R-curve relative L2 difference from `paper` (%)\n(reference itself drawn at 0.01%)")
+    axes[0].legend(fontsize=7, loc="upper left")
+    fig.suptitle(title, fontsize=10)
+    return save_figure(fig, out_dir, "pareto")
+
+
+def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    ok = [r for r in rows if r.get("status") == "completed"]
+    for integ, color in (("lumped", "C0"), ("paper", "C1")):
+        for he, marker in ((0.3, "o"), (0.2, "s"), (0.15, "^")):
+            pts = sorted([r for r in ok if r["integrator"] == integ and abs(r["h_e"] - he) < 1e-9],
+                         key=lambda r: r["dof"])
+            if not pts:
+                continue
+            dof = np.array([r["dof"] for r in pts])
+            label = f"{integ}, h_e = {he} d"
+            axes[0].loglog(dof, [r["s_per_step"] for r in pts], marker=marker, color=color,
+                           ls="-" if he == 0.3 else "none", label=label)
+            if "est_run_s" in pts[0]:
+                axes[1].loglog(dof, [r["est_run_s"] / 3600 for r in pts], marker=marker, color=color,
+                               ls="-" if he == 0.3 else "none", label=label)
+        size = sorted([r for r in ok if r["integrator"] == integ and abs(r["h_e"] - 0.3) < 1e-9],
+                      key=lambda r: r["dof"])
+        if len(size) >= 2:
+            slope = np.polyfit(np.log([r["dof"] for r in size]), np.log([r["s_per_step"] for r in size]), 1)[0]
+            axes[0].text(0.03, 0.95 - 0.06 * (integ == "paper"), f"{integ}: time/step ~ DOF^{slope:.2f}",
+                         transform=axes[0].transAxes, color=color, fontsize=8, va="top")
+    axes[0].set_xlabel("DOF")
+    axes[0].set_ylabel("wall time per step (s), 1 thread")
+    axes[1].set_xlabel("DOF")
+    axes[1].set_ylabel("estimated wall time of one run to the stop (h), 1 thread")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(title, fontsize=10)
+    return save_figure(fig, out_dir, "cost_growth")
+
+
+def save_figure(fig, out_dir, stem) -> list[pathlib.Path]:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for ext in ("pdf", "png"):
+        p = out_dir / f"{stem}.{ext}"
+        fig.savefig(p, dpi=150 if ext == "png" else None, bbox_inches="tight")
+        written.append(p)
+        print(p)
+    plt.close(fig)
+    return written
+
+
+def machine() -> str:
+    cpu = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30
+    return f"{cpu}, {os.cpu_count()} cores, {mem:.0f} GiB, {platform.system()} {platform.release()}"
+
+
+def git_hash() -> str:
+    try:
+        h = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                           text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+        return h + ("-dirty" if dirty else "")
+    except OSError:
+        return "unknown"
+
+
+def fmt(v, spec=".3g"):
+    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def summary_markdown(rows, crows, header: dict) -> str:
+    L = [f"# Bench results ({header['date']})", "",
+         f"Machine: {header['machine']}. Solver {header['git']}. Preset `{header['preset']}`; "
+         f"{header['jobs']} runs at a time; whole bench {header['total_min']:.0f} min. "
+         f"Reference: `{REFERENCE}` at the preset's rate (the slowest measured). "
+         f"Error bound: R-curve relative L2 <= {ERROR_BOUND:.0%}.", ""]
+    for case in dict.fromkeys(r["case"] for r in rows):
+        pts = [r for r in rows if r["case"] == case]
+        ok = [r for r in pts if within_bound(r) and r["variant"] != REFERENCE]
+        best = max(ok, key=lambda r: r["speedup_wall"]) if ok else None
+        L += [f"## {case}", ""]
+        if best:
+            L += [f"Fastest within the bound: **{best['variant']}**, {best['speedup_wall']:.1f}x faster than "
+                  f"`{REFERENCE}` by wall time ({best['speedup_cpu']:.1f}x by CPU time), R-curve L2 "
+                  f"{best['rcurve_rel_l2']:.2%}.", ""]
+        else:
+            L += ["No fast variant within the bound.", ""]
+        L += ["| variant | wall s | CPU s | steps | DOF-upd/s/core | MB | speed-up | R-curve L2 | R_init diff "
+              "| R_ss diff | broken rods (diff) | KE/SE max | status |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in pts:
+            if "rcurve_rel_l2" not in r:
+                L.append(f"| {r['variant']} | {fmt(r['wall_s'], '.0f')} | | | | | | | | | | | {r.get('status')} |")
+                continue
+            L.append(f"| {r['variant']} | {r['wall_s']:.0f} | {r['cpu_s']:.0f} | {r['steps']} | "
+                     f"{r['dof_updates_per_s_per_core'] / 1e6:.1f} M | {r['peak_memory_mb']:.0f} | "
+                     f"{r['speedup_wall']:.1f} | {r['rcurve_rel_l2']:.2%} | {r['R_init_rel_diff']:+.1%} | "
+                     f"{r['R_ss_rel_diff']:+.1%} | {r['broken_rods']} ({r['broken_rods_diff']:+d}) | "
+                     f"{fmt(r['max_kinetic_over_strain'])} | {r['status']} |")
+        L.append("")
+    if crows:
+        L += ["## Cost growth (1 thread, the theta_D = 30 case)", "",
+              "| integrator | w_s x h_s (d) | h_e (d) | DOF | dt | s/step | DOF-upd/s | set-up s | MB "
+              "| est. steps/run | est. h/run | est. h/run at v_app = 1e-3 c_d |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in crows:
+            if r.get("status") != "completed":
+                L.append(f"| {r['integrator']} | | | | | | | | | | {r.get('status')} |")
+                continue
+            L.append(f"| {r['integrator']} | {r['w_s']:.0f} x {r['h_s']:.0f} | {r['h_e']} | {r['dof']} | "
+                     f"{r['dt']:.3g} | {r['s_per_step']:.3g} | {r['dof_updates_per_s'] / 1e6:.1f} M | "
+                     f"{r['setup_s']:.1f} | {r['peak_memory_mb']:.0f} | {fmt(r.get('est_steps_per_run'), '.3g')} | "
+                     f"{fmt(r.get('est_run_s', math.nan) / 3600, '.3g')} | "
+                     f"{fmt(r.get('est_run_s_at_1e-3', math.nan) / 3600, '.3g')} |")
+        L.append("")
+        L.append(header.get("cost_note", ""))
+    return "\n".join(L) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=2, help="cores to use: runs at a time (default 2)")
+    ap.add_argument("--out", type=pathlib.Path, default=paths.BENCH,
+                    help=f"where results.csv, cost_growth.csv, results.md and out/ go (default {paths.BENCH})")
+    ap.add_argument("--runs", type=pathlib.Path, default=paths.BENCH_RUNS,
+                    help=f"where the runs go (default {paths.BENCH_RUNS})")
+    ap.add_argument("--quick", action="store_true",
+                    help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
+    ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")
+    a = ap.parse_args(argv)
+    if not solver().exists():
+        print(f"run_bench.py: solver binary {solver()} not found: run `make build`", file=sys.stderr)
+        return 2
+    global PRESET
+    variants, cases, sizes, extra = VARIANTS, CASES, COST_SIZES, {}
+    if a.quick:
+        PRESET = "ci"
+        variants = {k: VARIANTS[k] for k in ("paper", "lumped", "lumped rate2")}
+        cases = CASES[:1]
+        sizes = [(8, 4, 0.3), (12, 6, 0.3)]
+        extra = {"w_s_over_d": 8, "h_s_over_d": 4, "stop_da_over_d": 1}
+    if a.runs.exists():
+        shutil.rmtree(a.runs)
+    t0 = time.perf_counter()
+    date = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+
+    jobs = speed_error_jobs(cases, variants, PRESET, a.runs, extra)
+    run_jobs(jobs, a.jobs)
+    rows = speed_error_rows(jobs)
+    a.out.mkdir(parents=True, exist_ok=True)
+    write_csv(rows, a.out / "results.csv")
+
+    crows, cost_note = [], ""
+    if not a.skip_cost:
+        ref = next((r for r in rows if r["variant"] == REFERENCE and r.get("status") == "completed"), None)
+        run_model = {}
+        if ref:
+            rr = common.load_result(a.runs / ref["case"] / REFERENCE / "result.h5")
+            run_model = dict(U_end=ref["U_end"], h_s=rr.param("h_s_over_d"),
+                             v_app_over_cd=rr.param("v_app_over_cd") * rr.param("rate_factor"))
+        cjobs = cost_jobs(a.runs, sizes, ("lumped", "paper"), {"stop_da_over_d": 1e3} if not a.quick else {})
+        run_jobs(cjobs, 1)   # one at a time: time per step without a neighbour on the other core
+        crows = cost_rows(cjobs, run_model)
+        write_csv(crows, a.out / "cost_growth.csv")
+        cost_note = ("Estimated steps per run = T_run/dt, T_run = ramp + U_end/v_app, U_end = U_end of the "
+                     f"`{REFERENCE}` run of {CASES[0]} at `{PRESET}` x sqrt(h_s/h_s,{PRESET}), at the "
+                     f"`{PRESET}` rate; the `paper` preset's rate is 1e-3 c_d (x{run_model.get('v_app_over_cd', 0) / 1e-3:.2g} "
+                     "more steps) and its crack goes 30 d instead of 12 d (more again): see the README.")
+    header = dict(date=date, machine=machine(), git=git_hash(), preset=PRESET, jobs=a.jobs,
+                  total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
+    title = f"enamel-dem bench, preset {PRESET}, {header['date']}, {header['machine'].split(',')[0]}"
+    pareto_figure(rows, a.out / "out", title)
+    if crows:
+        cost_figure(crows, a.out / "out", title)
+    md = a.out / "results.md"
+    md.write_text(summary_markdown(rows, crows, header))
+    print(md)
+    bad = [r for r in rows if r.get("exit_code") != 0]
+    for r in bad:
+        print(f"run_bench.py: {r['case']} / {r['variant']} exited {r['exit_code']}: see its bench.log",
+              file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

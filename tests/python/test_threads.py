@@ -1,0 +1,48 @@
+"""Multithreading (issue "Speed against error"): the force loops run in parallel with OpenMP, and a run with
+2 threads gives the same result as with 1 thread, bit for bit: R-curve, the whole /history (energies,
+J, counts) and the final damage state. Both integrators; a small case in which rods and interfaces break."""
+import h5py
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+CASE = ROOT / "paper_cases" / "theta30_s7.1_e10_cv0.toml"
+SETS = {"lumped": ["w_s_over_d=12", "h_s_over_d=6", "stop_da_over_d=3"],
+        "paper": ["w_s_over_d=8", "h_s_over_d=4", "stop_da_over_d=1.5", 'integrator="paper"']}
+
+
+def result_arrays(path):
+    """Every dataset of /rcurve, /history and the last frame, and the step count."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        for group in ("rcurve", "history"):
+            for name, ds in f[group].items():
+                out[f"{group}/{name}"] = ds[:]
+        last = f["frames"][str(max(int(k) for k in f["frames"]))]
+        for name in ("iface_damage", "beam_broken", "node_displacement"):
+            out[f"frame/{name}"] = last[name][:]
+        out["steps"] = np.array([f["meta"].attrs["steps"]])
+        out["threads"] = np.array([f["meta"].attrs["threads"]])
+        status = f["meta"].attrs["status"]
+    return out, status
+
+
+@pytest.mark.parametrize("integrator", ["lumped", "paper"])
+def test_two_threads_give_the_one_thread_result(integrator, run, tmp_path):
+    results = {}
+    for threads in (1, 2):
+        out = tmp_path / f"t{threads}"
+        args = ["run", CASE, "--preset", "ci", "--out", out, "--quiet", "--set", f"threads={threads}"]
+        for s in SETS[integrator]:
+            args += ["--set", s]
+        r = run(*args)
+        assert r.returncode == 0, r.stderr
+        results[threads], status = result_arrays(out / "result.h5")
+        assert status == "completed"
+        assert results[threads]["threads"][0] == threads
+    one, two = results[1], results[2]
+    assert one["history/broken_rod_elements"][-1] > 0 and one["history/failed_interfaces"][-1] > 0, \
+        "the case should break rods and interfaces"
+    differing = [k for k in one if k != "threads" and not np.array_equal(one[k], two[k])]
+    assert differing == [], f"results differ between 1 and 2 threads in: {differing}"
