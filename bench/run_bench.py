@@ -41,6 +41,7 @@ import paths  # noqa: E402
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 ERROR_BOUND = 0.02   # R-curve relative L2 difference from the reference: "within the error bound"
 PRESET = "reduced"
@@ -289,10 +290,11 @@ def pareto_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]
         ax.set_yscale("log")
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", alpha=0.3)
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     axes[0].set_ylabel("R-curve relative L2 difference from `paper` (%)\n(reference itself drawn at 0.01%)")
     axes[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(title, fontsize=10)
-    return save_figure(fig, out_dir, "pareto")
+    return common.save_to(fig, out_dir, "pareto")
 
 
 def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
@@ -311,33 +313,29 @@ def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
             if "est_run_s" in pts[0]:
                 axes[1].loglog(dof, [r["est_run_s"] / 3600 for r in pts], marker=marker, color=color,
                                ls="-" if he == 0.3 else "none", label=label)
+            if "est_run_s_at_1e-3" in pts[0] and he == 0.3:
+                axes[1].loglog(dof, [r["est_run_s_at_1e-3"] / 3600 for r in pts], marker=marker, color=color,
+                               ls="--", mfc="none", label=f"{integ}, at v_app = 1e-3 c_d (paper preset rate)")
+                last = pts[-1]
+                axes[1].annotate(f"{last['est_run_s_at_1e-3'] / 3600:.3g} h", (last["dof"],
+                                 last["est_run_s_at_1e-3"] / 3600), fontsize=7, xytext=(-30, 6),
+                                 textcoords="offset points", color=color)
         size = sorted([r for r in ok if r["integrator"] == integ and abs(r["h_e"] - 0.3) < 1e-9],
                       key=lambda r: r["dof"])
         if len(size) >= 2:
             slope = np.polyfit(np.log([r["dof"] for r in size]), np.log([r["s_per_step"] for r in size]), 1)[0]
-            axes[0].text(0.03, 0.95 - 0.06 * (integ == "paper"), f"{integ}: time/step ~ DOF^{slope:.2f}",
-                         transform=axes[0].transAxes, color=color, fontsize=8, va="top")
+            axes[0].text(0.97, 0.10 - 0.06 * (integ == "paper"), f"{integ}: time/step ~ DOF^{slope:.2f}",
+                         transform=axes[0].transAxes, color=color, fontsize=8, ha="right")
     axes[0].set_xlabel("DOF")
     axes[0].set_ylabel("wall time per step (s), 1 thread")
     axes[1].set_xlabel("DOF")
-    axes[1].set_ylabel("estimated wall time of one run to the stop (h), 1 thread")
+    axes[1].set_ylabel("estimated wall time of one run (h), 1 thread")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     fig.suptitle(title, fontsize=10)
-    return save_figure(fig, out_dir, "cost_growth")
-
-
-def save_figure(fig, out_dir, stem) -> list[pathlib.Path]:
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
-    for ext in ("pdf", "png"):
-        p = out_dir / f"{stem}.{ext}"
-        fig.savefig(p, dpi=150 if ext == "png" else None, bbox_inches="tight")
-        written.append(p)
-        print(p)
-    plt.close(fig)
-    return written
+    return common.save_to(fig, out_dir, "cost_growth")
 
 
 def machine() -> str:
@@ -417,6 +415,32 @@ def summary_markdown(rows, crows, header: dict) -> str:
     return "\n".join(L) + "\n"
 
 
+def read_csv(path: pathlib.Path) -> list[dict]:
+    def value(v):
+        try:
+            return int(v)
+        except ValueError:
+            try:
+                return float(v)
+            except ValueError:
+                return v
+    with open(path) as f:
+        return [{k: value(v) for k, v in row.items() if v != ""} for row in csv.DictReader(f)]
+
+
+def replot(out: pathlib.Path) -> int:
+    """The figures again from the CSV files of a finished bench (drawing only; the numbers are not touched)."""
+    rows = read_csv(out / "results.csv")
+    cost = out / "cost_growth.csv"
+    crows = read_csv(cost) if cost.exists() else []
+    first = (out / "results.md").read_text().splitlines()[0] if (out / "results.md").exists() else ""
+    title = f"enamel-dem bench {first.removeprefix('# Bench results').strip()}"
+    pareto_figure(rows, out / "out", title)
+    if crows:
+        cost_figure(crows, out / "out", title)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=2, help="cores to use: runs at a time (default 2)")
@@ -427,7 +451,11 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
     ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")
+    ap.add_argument("--replot", action="store_true",
+                    help="run nothing: redraw the figures from OUT/results.csv and OUT/cost_growth.csv")
     a = ap.parse_args(argv)
+    if a.replot:
+        return replot(a.out)
     if not solver().exists():
         print(f"run_bench.py: solver binary {solver()} not found: run `make build`", file=sys.stderr)
         return 2
@@ -466,7 +494,9 @@ def main(argv=None) -> int:
                      f"`{REFERENCE}` run of {CASES[0]} at `{PRESET}` x sqrt(h_s/h_s,{PRESET}), at the "
                      f"`{PRESET}` rate; the `paper` preset's rate is 1e-3 c_d (x{run_model.get('v_app_over_cd', 0) / 1e-3:.2g} "
                      "more steps) and its crack goes 30 d instead of 12 d (more again): see the README.")
-    header = dict(date=date, machine=machine(), git=git_hash(), preset=PRESET, jobs=a.jobs,
+    ref_meta = next((meta_of(j.out / "result.h5") for j in jobs if j.key.endswith(f"/ {REFERENCE}")
+                     and (j.out / "result.h5").exists()), {})
+    header = dict(date=date, machine=machine(), git=ref_meta.get("git_hash", git_hash()), preset=PRESET, jobs=a.jobs,
                   total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
     title = f"enamel-dem bench, preset {PRESET}, {header['date']}, {header['machine'].split(',')[0]}"
     pareto_figure(rows, a.out / "out", title)

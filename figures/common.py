@@ -330,11 +330,15 @@ def case_label(r: Result, keys=("theta_D", "sigma_ru_over_sigma0", "Er_over_kd")
 
 
 def save(fig, preset: str, stem: str, out=None) -> list[pathlib.Path]:
-    d = paths.figure_dir(preset, out)
-    d.mkdir(parents=True, exist_ok=True)
+    return save_to(fig, paths.figure_dir(preset, out), stem)
+
+
+def save_to(fig, directory: pathlib.Path, stem: str) -> list[pathlib.Path]:
+    """Write fig as DIRECTORY/STEM.pdf and .png (150 dpi), close it, print and return the paths."""
+    directory.mkdir(parents=True, exist_ok=True)
     written = []
     for ext in ("pdf", "png"):
-        p = d / f"{stem}.{ext}"
+        p = directory / f"{stem}.{ext}"
         fig.savefig(p, dpi=150 if ext == "png" else None, bbox_inches="tight")
         written.append(p)
     plt.close(fig)
