@@ -11,8 +11,8 @@
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
-#   make bench         speed against error of every integrator and knob, and cost growth, in one run (~1.5 h on
-#                      2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#   make bench          speed against error of every integrator and knob, and cost growth, in one run (~1.5 h on
+#                       2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 

@@ -132,8 +132,11 @@ const Preset kPresets[] = {
     {"ci",
      "w_s_over_d = 16\nh_s_over_d = 8\nh_e_over_d = 0.3\nv_app_over_cd = 2e-3\nintegrator = \"lumped\"\n"
      "stop_da_over_d = 5\nframes_da_over_d = [1, 2.5, 5]\n"},
+    // reduced: dt_factor 0.22 with damping_cap 0.5 is the fastest setting that `make bench` found to leave the
+    // error against `paper` unchanged (theta30: L2 1.55% vs 1.49% at dt_factor 0.1; 2.6x faster)
     {"reduced",
      "w_s_over_d = 40\nh_s_over_d = 20\nh_e_over_d = 0.3\nv_app_over_cd = 2.5e-3\nintegrator = \"lumped\"\n"
+     "dt_factor = 0.22\ndamping_cap = 0.5\n"
      "stop_da_over_d = 12\nframes_da_over_d = [3, 6, 12]\n"},
     {"paper",
      "w_s_over_d = 200\nh_s_over_d = 200\nh_e_over_d = 0.3\nv_app_over_cd = 1e-3\nintegrator = \"paper\"\n"
