@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "version.hpp"
 #include "beam.hpp"
 #include "case_params.hpp"
 #include "exit_codes.hpp"
@@ -145,7 +146,7 @@ int main(int argc, char** argv) {
   CLI::App app{"enamel-dem: discrete element fracture of decussating crossply microstructures (tooth enamel),\n"
                "after Pro & Barthelat 2020, J. Mech. Phys. Solids. Normalised units: d = E_r = rho_r = 1."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string(ENAMEL_VERSION) + " (" + ENAMEL_GIT_HASH + ")");
+  app.set_version_flag("--version", std::string(ENAMEL_VERSION) + " (" + enamel::kGitHash + ")");
 
   CaseArgs infoArgs, runArgs;
   CLI::App* info = app.add_subcommand("info", "print the model built from a case: counts of rods, nodes, beam "

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "strength.hpp"
+#include "version.hpp"
 
 namespace enamel {
 
@@ -168,7 +169,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "preset", p.presetName);
       attr(g.id, "solver", "enamel-dem");
       attr(g.id, "solver_version", ENAMEL_VERSION);
-      attr(g.id, "git_hash", ENAMEL_GIT_HASH);
+      attr(g.id, "git_hash", kGitHash);
       attr(g.id, "integrator", sim.integrator->name());
       attr(g.id, "integrator_details", sim.integrator->describe());
       attr(g.id, "added_rotary_inertia", sim.addedRotaryInertia);
