@@ -81,15 +81,19 @@ COST_WORK = {"lumped": 3e8, "paper": 6e7}   # DOF x steps per cost run
 
 @dataclasses.dataclass
 class Job:
-    key: str                 # unique name (directory under runs/bench/)
+    case: str                # the case, or "cost" for the cost-growth runs
+    variant: str             # the variant's name, or (cost) the integrator
     args: list
     cores: int
     out: pathlib.Path
     expected_s: float = 0.0  # for ordering: longest first
     wall_s: float = math.nan
     cpu_s: float = math.nan
-    maxrss_mb: float = math.nan
     returncode: int = -1
+
+    @property
+    def key(self) -> str:
+        return f"{self.case} / {self.variant} ({self.out.name})"
 
 
 def solver() -> pathlib.Path:
@@ -105,7 +109,8 @@ def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path) -> 
 
 def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
     """Run the jobs, longest first, never using more than `cores` cores; records wall, CPU and peak memory of
-    each (os.wait4 gives the child's own rusage)."""
+    each (os.wait4 gives the child's own CPU time; its maxrss would count the forking Python's pages, so peak
+    memory comes from the solver's /meta/peak_memory_mb)."""
     pending = sorted(jobs, key=lambda j: -j.expected_s)
     running = {}   # pid -> (job, start, popen)
     free = cores
@@ -133,21 +138,19 @@ def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
         j.returncode = p.returncode
         j.wall_s = time.perf_counter() - t0
         j.cpu_s = ru.ru_utime + ru.ru_stime
-        j.maxrss_mb = ru.ru_maxrss / 1024.0
         free += j.cores
         log(f"[{time.perf_counter() - t_all:7.0f} s] {j.key}: exit {j.returncode}, {j.wall_s:.1f} s wall, "
-            f"{j.cpu_s:.1f} s CPU, {j.maxrss_mb:.0f} MB")
+            f"{j.cpu_s:.1f} s CPU")
 
 
-def meta_of(result_h5) -> dict:
+def history_end(result_h5) -> dict:
+    """The last /history row's applied displacement, time and energy-balance error (common.load_result
+    reads /meta and the R-curve, not these)."""
     import h5py
     with h5py.File(result_h5, "r") as f:
-        m = common._attrs(f["meta"])
         h = f["history"]
-        m["U_end"] = float(h["applied_displacement"][-1])
-        m["t_end"] = float(h["time"][-1])
-        m["balance_end"] = float(h["energy_balance_error"][-1])
-    return m
+        return dict(U_end=float(h["applied_displacement"][-1]), t_end=float(h["time"][-1]),
+                    balance_end=float(h["energy_balance_error"][-1]))
 
 
 # ------------------------------------------------------------------------------------------- speed vs error
@@ -159,30 +162,27 @@ def speed_error_jobs(cases, variants, preset, runs: pathlib.Path, extra_sets: di
                 continue
             out = runs / case / name.replace(" ", "_")
             expected = 100.0 if name == REFERENCE else 1.0 / threads
-            jobs.append(Job(key=f"{case} / {name}", cores=threads, out=out, expected_s=expected,
+            jobs.append(Job(case=case, variant=name, cores=threads, out=out, expected_s=expected,
                             args=run_args(paths.case_file(case), preset, {**sets, **extra_sets}, threads, out)))
     return jobs
 
 
 def speed_error_rows(jobs: list[Job]) -> list[dict]:
-    by_key = {j.key: j for j in jobs}
+    reference = {j.case: j for j in jobs if j.variant == REFERENCE}
     rows = []
     for j in jobs:
-        case, name = j.key.split(" / ")
-        ref_job = by_key[f"{case} / {REFERENCE}"]
-        row = dict(case=case, variant=name, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s,
-                   peak_memory_mb=j.maxrss_mb)
+        case, ref_job = j.case, reference[j.case]
+        row = dict(case=case, variant=j.variant, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s)
         try:
             r = common.load_result(j.out / "result.h5", case=case)
             ref = common.load_result(ref_job.out / "result.h5", case=case)
-            m = meta_of(j.out / "result.h5")
+            m = {**r.meta, **history_end(j.out / "result.h5")}
         except (common.MissingResult, OSError, KeyError) as e:
             row.update(status=f"no result ({e})")
             rows.append(row)
             continue
-        threads = int(m.get("threads", 1))
-        row["peak_memory_mb"] = m.get("peak_memory_mb", j.maxrss_mb)
-        row.update(
+        threads = int(m["threads"])
+        row.update(peak_memory_mb=m["peak_memory_mb"],
             status=r.status, integrator=m["integrator"], threads=threads, dt=m["dt"], steps=int(m["steps"]),
             dof=int(m["dof"]), stepping_s=m["wall_time_s"],
             dof_updates_per_s_per_core=m["dof"] * m["steps"] / m["wall_time_s"] / threads,
@@ -213,7 +213,7 @@ def cost_jobs(runs: pathlib.Path, sizes, integrators, extra_sets: dict) -> list[
             out = runs / "cost" / f"{integ}_w{w}_h{h}_he{he}"
             sets = {**VARIANTS[integ][0], "w_s_over_d": w, "h_s_over_d": h, "h_e_over_d": he,
                     "max_steps": steps, **extra_sets}
-            jobs.append(Job(key=f"cost / {integ} {w}x{h} h_e {he}", cores=1, out=out, expected_s=dof_est * 1e-9,
+            jobs.append(Job(case="cost", variant=integ, cores=1, out=out, expected_s=dof_est * 1e-9,
                             args=run_args(paths.case_file(COST_CASE), PRESET, sets, 1, out)))
     return jobs
 
@@ -224,21 +224,17 @@ def cost_rows(jobs: list[Job], run_model: dict) -> list[dict]:
     sqrt(h_s) for this grip loading); this leaves out that the paper preset's crack goes 30 d, not 12 d."""
     rows = []
     for j in jobs:
-        _, rest = j.key.split(" / ")
-        integ = rest.split()[0]
-        row = dict(integrator=integ, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s,
-                   peak_memory_mb=j.maxrss_mb)
+        row = dict(integrator=j.variant, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s)
         try:
-            m = meta_of(j.out / "result.h5")
-        except OSError as e:
+            r = common.load_result(j.out / "result.h5")
+        except (common.MissingResult, OSError) as e:
             row.update(status=f"no result ({e})")
             rows.append(row)
             continue
-        r = common.load_result(j.out / "result.h5")
-        w, h, he, rate = (r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "v_app_over_cd"))
+        m = r.meta
+        w, h, he = (r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d"))
         per_step = m["wall_time_s"] / m["steps"]
-        row["peak_memory_mb"] = m.get("peak_memory_mb", j.maxrss_mb)
-        row.update(status=m["status"], w_s=w, h_s=h, h_e=he, dof=int(m["dof"]), steps=int(m["steps"]),
+        row.update(peak_memory_mb=m["peak_memory_mb"], status=m["status"], w_s=w, h_s=h, h_e=he, dof=int(m["dof"]), steps=int(m["steps"]),
                    dt=m["dt"], setup_s=j.wall_s - m["wall_time_s"], s_per_step=per_step,
                    dof_updates_per_s=m["dof"] / per_step)
         if run_model:
@@ -353,17 +349,6 @@ def machine() -> str:
         pass
     mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30
     return f"{cpu}, {os.cpu_count()} cores, {mem:.0f} GiB, {platform.system()} {platform.release()}"
-
-
-def git_hash() -> str:
-    try:
-        h = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                           text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
-        return h + ("-dirty" if dirty else "")
-    except OSError:
-        return "unknown"
 
 
 def fmt(v, spec=".3g"):
@@ -499,9 +484,9 @@ def main(argv=None) -> int:
                      f"`{REFERENCE}` run of {CASES[0]} at `{PRESET}` x sqrt(h_s/h_s,{PRESET}), at the "
                      f"`{PRESET}` rate; the `paper` preset's rate is 1e-3 c_d (x{run_model.get('v_app_over_cd', 0) / 1e-3:.2g} "
                      "more steps) and its crack goes 30 d instead of 12 d (more again): see the README.")
-    ref_meta = next((meta_of(j.out / "result.h5") for j in jobs if j.key.endswith(f"/ {REFERENCE}")
-                     and (j.out / "result.h5").exists()), {})
-    header = dict(date=date, machine=machine(), git=ref_meta.get("git_hash", git_hash()), preset=PRESET, jobs=a.jobs,
+    ref_h5 = next((j.out / "result.h5" for j in jobs if j.variant == REFERENCE), None)
+    solver_hash = common.load_result(ref_h5).meta["git_hash"] if ref_h5 and ref_h5.exists() else "unknown"
+    header = dict(date=date, machine=machine(), git=solver_hash, preset=PRESET, jobs=a.jobs,
                   total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
     title = f"enamel-dem bench, preset {PRESET}, {header['date']}, {header['machine'].split(',')[0]}"
     pareto_figure(rows, a.out / "out", title)

@@ -7,8 +7,7 @@ FIGURE_LIST = PAPER_CASES / "figures.toml"
 PAPER_VALUES = ROOT / "figures" / "paper_values.toml"
 RUNS = ROOT / "runs"
 FIGURES_OUT = ROOT / "figures" / "out"
-BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.csv, results.md (committed)
-BENCH_OUT = BENCH / "out"               # ... and its figures (generated, git-ignored)
+BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.csv, results.md (committed), out/
 BENCH_RUNS = RUNS / "bench"             # ... and its runs
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
 

@@ -10,7 +10,6 @@
 #include <fstream>
 #include <iostream>
 
-#include "version.hpp"
 #include "beam.hpp"
 #include "case_params.hpp"
 #include "exit_codes.hpp"
@@ -18,6 +17,7 @@
 #include "integrators.hpp"
 #include "runner.hpp"
 #include "simulation.hpp"
+#include "version.hpp"
 
 namespace fs = std::filesystem;
 using namespace enamel;

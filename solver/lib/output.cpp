@@ -73,7 +73,6 @@ double peakMemoryMB() {
   return kb / 1024.0;
 }
 
-
 // --- a thin RAII layer over the HDF5 C API ---
 struct Handle {
   hid_t id;
