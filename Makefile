@@ -13,6 +13,9 @@
 #
 #   make bench          speed against error of every integrator and knob, and cost growth, in one run (~1.5 h on
 #                       2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
+#                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
+#                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 
@@ -39,7 +42,7 @@ PRESETS := ci reduced paper
 RUNS := runs
 FIG_OUT := figures/out/$(PRESET)
 
-.PHONY: bench help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
+.PHONY: bench bench-paper help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -77,6 +80,9 @@ clean:
 
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) bench/run_bench.py --jobs $(JOBS)
+
+bench-paper: $(ENAMEL)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) bench/paper_preset.py --threads $(JOBS)
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.

@@ -9,6 +9,7 @@ RUNS = ROOT / "runs"
 FIGURES_OUT = ROOT / "figures" / "out"
 BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.csv, results.md (committed), out/
 BENCH_RUNS = RUNS / "bench"             # ... and its runs
+BENCH_PAPER_PRESET = BENCH_RUNS / "paper_preset"  # make bench-paper: the one paper-preset case
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
 
 

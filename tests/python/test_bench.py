@@ -1,12 +1,17 @@
 """The bench script itself (issue "Speed against error"), in its --quick mode (tiny specimens at the ci preset):
 it runs, writes results.csv, cost_growth.csv, results.md and both figures, measures the reference against
 itself as zero error, and computes the errors of the other variants against it. Correctness only: no
-timing is asserted here (`make bench` measures)."""
+timing is asserted here (`make bench` measures). Also `make bench-paper`'s script (bench/paper_preset.py):
+interrupted and continued."""
 import csv
 import math
 import os
+import signal
 import subprocess
 import sys
+import time
+
+import h5py
 
 from conftest import ROOT
 
@@ -41,3 +46,43 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
         assert (tmp_path / "out" / name).stat().st_size > 1000
     md = (tmp_path / "results.md").read_text()
     assert "Fastest within the bound" in md or "No fast variant within the bound" in md
+
+
+PAPER_PRESET = ROOT / "bench" / "paper_preset.py"
+
+
+def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
+    """`make bench-paper` in --quick mode: Ctrl-C (SIGINT to the process group, as a terminal sends it)
+    leaves a checkpoint and an 'interrupted' report and exits non-zero; the same command continues the run
+    to its end, and a third call only reports."""
+    env = dict(os.environ, ENAMEL_BINARY=str(enamel))
+    cmd = [sys.executable, str(PAPER_PRESET), "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
+           "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
+    run = tmp_path / "runs" / "theta30_s21.4_e10_cv0"
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and not (run / "result.h5").exists():   # first progress write
+        time.sleep(0.2)
+    os.killpg(p.pid, signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 12, (p.returncode, err)   # the solver's "interrupted"
+    assert (run / "checkpoint.bin").exists()
+    md = (tmp_path / "paper_preset.md").read_text()
+    assert "status: **interrupted**" in md and "not finished" in md
+    steps_before = int(h5py.File(run / "result.h5")["meta"].attrs["steps"])
+    assert 0 < steps_before < 120000
+
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "continuing from the checkpoint" in r.stdout
+    md = (tmp_path / "paper_preset.md").read_text()
+    assert "status: **completed**" in md
+    assert "interrupted after" in (run / "log.txt").read_text()   # the first part's last lines were logged
+    assert "2 sessions" in md
+    assert sum(line.startswith("# ") for line in open(run / "log.txt")) == 2
+    for name in ("paper_preset.png", "paper_preset.pdf"):
+        assert (tmp_path / "out" / name).stat().st_size > 1000
+
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "is complete; reporting it" in r.stdout

@@ -1,0 +1,257 @@
+#!/usr/bin/env python3
+"""`make bench-paper`: one `paper`-preset case run to Delta_a/d = 30 with the fastest scheme that stays within
+the bench's error bound, its time and R-curve reported.
+
+The case is the bench's first (Fig. 4's theta_D = 30, sigma_ru/sigma0 = 21.4, Er/kd = 10) at the `paper`
+preset (200 d x 200 d, h_e = 0.3 d, 1.39 M DOF, v_app = 1e-3 c_d, stop at Delta_a = 30 d), integrator
+`lumped` with dt_factor 0.22 and damping_cap 0.5 (bench/results.md: 72x faster than `paper` at 1.55% R-curve
+error on the reduced case; the faster `rate2` variant is within the bound too but breaks the quasi-static
+check, KE/SE 0.078 > 0.05), on 2 threads. It takes hours, so it is resumable: Ctrl-C (or SIGTERM) writes a
+checkpoint and stops; the same command again continues from it (the result is the same, bit for bit at the
+same thread count). A checkpoint is also written every --checkpoint-every seconds.
+
+Then it writes bench/paper_preset.md (committed: the README quotes it) and bench/out/paper_preset.{pdf,png}:
+the R-curve against the same case at the `reduced` size (the `paper` scheme and the same fast scheme, from
+`make bench`, when their runs are there) and the paper's value, and the process zone at the last frame.
+An unfinished run is reported as such (how far it got, how long it took so far).
+"""
+import argparse
+import datetime
+import math
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "figures"))
+sys.path.insert(0, str(ROOT / "bench"))
+import common  # noqa: E402
+import paths  # noqa: E402
+import run_bench  # noqa: E402
+
+import matplotlib  # noqa: E402
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+CASE = run_bench.CASES[0]
+VARIANT = "lumped cap0.5 dt0.22"   # the fastest within the bound without a quasi-static warning (see above)
+PRESET = "paper"
+EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests)
+RUNS = paths.BENCH_PAPER_PRESET    # --runs
+OUT = paths.BENCH                  # --out: paper_preset.md and out/paper_preset.{pdf,png}
+
+
+def run_dir() -> pathlib.Path:
+    return RUNS / CASE
+
+
+def solver_command(threads: int, checkpoint_every: float, restart: bool) -> list:
+    out = run_dir()
+    sets, _ = run_bench.VARIANTS[VARIANT]
+    args = run_bench.run_args(paths.case_file(CASE), PRESET, {**sets, **EXTRA_SETS}, threads, out)
+    args.remove("--quiet")   # progress lines (with an ETA) go to the terminal and the log
+    args.remove("--force")
+    args += ["--checkpoint-every", str(checkpoint_every)]
+    return args + (["--restart"] if restart else ["--force"])
+
+
+def run(threads: int, checkpoint_every: float) -> int:
+    """Run the case, or continue it from its checkpoint; progress to the terminal and to DIR/log.txt."""
+    out = run_dir()
+    out.mkdir(parents=True, exist_ok=True)
+    result = out / "result.h5"
+    if result.exists():
+        try:
+            status = common.load_result(result, case=CASE).status
+        except (OSError, KeyError):
+            status = "unreadable"
+        if status == "completed":
+            print(f"paper_preset.py: {result} is complete; reporting it (delete it to run again)")
+            return 0
+    restart = (out / "checkpoint.bin").exists()
+    cmd = solver_command(threads, checkpoint_every, restart)
+    with open(out / "log.txt", "a") as log:
+        log.write(f"# {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC: {' '.join(cmd)}\n")
+        log.flush()
+        print(("continuing from the checkpoint: " if restart else "") + " ".join(cmd), flush=True)
+        proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, bufsize=1)
+        while True:   # Ctrl-C reaches the solver too: it writes its checkpoint and stops; read its last lines
+            try:
+                for line in proc.stderr:
+                    sys.stderr.write(line)
+                    log.write(line)
+                    log.flush()
+                rc = proc.wait()
+                break
+            except KeyboardInterrupt:
+                continue
+    if rc != 0:
+        print(f"paper_preset.py: the solver exited {rc}; run `make bench-paper` again to continue from the "
+              f"last checkpoint ({out / 'checkpoint.bin'})", file=sys.stderr)
+    return rc
+
+
+def bench_row(variant: str) -> dict:
+    """The bench's row for this case and variant (bench/results.csv), or {}."""
+    try:
+        rows = run_bench.read_csv(paths.BENCH / "results.csv")
+    except OSError:
+        return {}
+    return next((r for r in rows if r["case"] == CASE and r["variant"] == variant), {})
+
+
+def reduced_results() -> dict:
+    """{label: Result} of this case at the `reduced` size from `make bench`'s runs, where they are."""
+    out = {}
+    for variant in (run_bench.REFERENCE, VARIANT):
+        p = paths.BENCH_RUNS / CASE / variant.replace(" ", "_") / "result.h5"
+        try:
+            out[f"reduced 40 d x 20 d, {variant}"] = common.load_result(p, case=CASE)
+        except (common.MissingResult, OSError):
+            pass
+    return out
+
+
+def cost_estimate_steps(r: common.Result) -> float:
+    """The cost-growth table's step estimate for the paper-preset size at the paper rate, rescaled to this
+    run's dt (the table's runs use the bench's dt_factor 0.1)."""
+    try:
+        rows = run_bench.read_csv(paths.BENCH / "cost_growth.csv")
+    except OSError:
+        return math.nan
+    row = next((c for c in rows if c.get("integrator") == "lumped" and c.get("w_s") == r.param("w_s_over_d")
+                and c.get("h_s") == r.param("h_s_over_d") and c.get("h_e") == r.param("h_e_over_d")), None)
+    return row["est_steps_per_run_at_1e-3"] * row["dt"] / r.meta["dt"] if row else math.nan
+
+
+def figure(r: common.Result, reduced: dict, title: str) -> list[pathlib.Path]:
+    fig, (ax, *maps) = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw=dict(width_ratios=[1.3, 1, 1, 1]),
+                                   layout="constrained")
+    common.draw_rcurve(ax, r, label=f"{PRESET} preset {r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d, {VARIANT}", color="C3")
+    for (label, rr), color in zip(reduced.items(), ("k", "C0")):
+        common.draw_rcurve(ax, rr, label=label, color=color, markersize=1.5, linewidth=0.9)
+    common.draw_paper_values(ax, [v for v in common.values_for_case(CASE) if v["quantity"] == "R_ss_over_Gamma"])
+    common.format_rcurve_axes(ax, f"{common.case_label(r)}{common.status_flag(r)}")
+    ax.legend(fontsize=7, loc="lower right")
+    if not r.frames:   # no frame written yet: the R-curve alone
+        for axm in maps:
+            axm.set_axis_off()
+        maps[1].text(0.5, 0.5, "no process-zone frame yet", ha="center", transform=maps[1].transAxes)
+    frame = r.frames[-1] if r.frames else None
+    a = r.geometry.attrs
+    x0, yc = float(a["a0"]), float(a["y_crack_plane"])
+    for axm, (name, tag, ply) in zip(maps if frame else [], common.MAP_PANELS):
+        common.draw_process_zone(axm, r, frame, tag, ply, title=f"{name} at $\\Delta a/d$ = {frame.da:.1f}")
+        # the crack-tip region (the specimen is 200 d), within the specimen
+        x_lo, x_hi = max(0.0, x0 - 5), min(float(a["w_s"]), x0 + max(35.0, frame.da + 10))
+        half = 0.5 * (x_hi - x_lo)
+        axm.set_xlim(x_lo, x_hi)
+        axm.set_ylim(max(0.0, yc - half), min(float(a["h_s"]), yc + half))
+    if frame:
+        maps[-1].legend(handles=common.map_legend_handles(), fontsize=6.5, loc="lower right")
+    fig.suptitle(title, fontsize=10)
+    return common.save_to(fig, OUT / "out", "paper_preset")
+
+
+def report() -> int:
+    h5 = run_dir() / "result.h5"
+    try:
+        r = common.load_result(h5, case=CASE, full=True)
+    except common.MissingResult:
+        print(f"paper_preset.py: no result {h5}: run `make bench-paper` first", file=sys.stderr)
+        return common.EXIT_MISSING
+    m, end = r.meta, run_bench.history_end(h5)
+    reduced = reduced_results()
+    row = bench_row(VARIANT)
+    steps, wall, threads, dof = int(m["steps"]), float(m["wall_time_s"]), int(m["threads"]), int(m["dof"])
+    est = cost_estimate_steps(r)
+    date = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    L = [f"# One `{PRESET}`-preset case (`make bench-paper`, report {date})", "",
+         f"Case `{CASE}` at the `{PRESET}` preset ({r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d, "
+         f"h_e = {r.param('h_e_over_d'):g} d, {dof:,} DOF, v_app = {r.param('v_app_over_cd'):g} c_d), "
+         f"variant `{VARIANT}` ({m['integrator_details']}), {threads} threads. "
+         f"Machine: {run_bench.machine()}. Solver {m['git_hash']}.", "",
+         f"- status: **{r.status}**" + (f" ({m['stop_reason']})" if m.get("stop_reason") else "") +
+         ("" if r.completed else " — not finished: `make bench-paper` continues it"),
+         f"- crack advance reached: {r.da_max:.2f} d of {r.param('stop_da_over_d'):g} d",
+         f"- wall time of the stepping: **{wall / 3600:.2f} h** ({wall:.0f} s; summed over the run's "
+         f"{max(1, _segments())} sessions, the work redone after a stop between checkpoints left out)",
+         f"- steps: {steps:,} (dt = {m['dt']:.4g} d/c_r); {steps / wall:.1f} steps/s; "
+         f"{dof * steps / wall / threads / 1e6:.1f} M DOF-updates/s per core",
+         f"- the cost-growth estimate (bench/cost_growth.csv, 200 x 200 d row at 1e-3 c_d, rescaled to this dt): "
+         f"{est:,.0f} steps to a 12 d crack" if math.isfinite(est) else "- no cost-growth estimate (run `make bench`)",
+         f"- peak memory {m['peak_memory_mb']:.0f} MB; broken rod elements {r.broken_rods}; "
+         f"max KE/SE while the crack grows {m['max_kinetic_over_strain_while_growing']:.3g}; "
+         f"energy balance error at the end {end['balance_end']:.2e}",
+         f"- warnings: {m['warnings'].strip() or 'none'}", ""]
+    if row:
+        L += [f"The variant on the reduced case (bench/results.md): {float(row['speedup_wall']):.1f}x faster than "
+              f"`paper`, R-curve L2 {float(row['rcurve_rel_l2']):.2%}.", ""]
+    L += ["| run | R_init/Gamma | R_ss/Gamma | R_m/Gamma | Delta_a max (d) | broken rod elements |",
+          "|---|---|---|---|---|---|",
+          f"| {PRESET} preset, {VARIANT} | {r.R_init:.3g} | {r.R_ss:.3g} | {r.R_m:.3g} | {r.da_max:.3g} | "
+          f"{r.broken_rods} |"]
+    for label, rr in reduced.items():
+        L.append(f"| {label} | {rr.R_init:.3g} | {rr.R_ss:.3g} | {rr.R_m:.3g} | {rr.da_max:.3g} | {rr.broken_rods} |")
+    for v in common.values_for_case(CASE):
+        if v["quantity"] == "R_ss_over_Gamma":
+            L.append(f"| paper (Pro & Barthelat 2020, {v['id']}) | | {common.paper_value_text(v)} | | | |")
+    L += ["", "R_ss is the mean R over the last 20% of the crack advance reached and R_m the mean over "
+          "0 < Delta_a/d < 30 (README, \"Solver\"), so the two sizes average different ranges.", ""]
+    title = f"enamel-dem, one {PRESET}-preset case ({VARIANT}), {date}"
+    figure(r, reduced, title)
+    md = OUT / "paper_preset.md"
+    md.write_text("\n".join(L))
+    print(md)
+    return 0
+
+
+def _segments() -> int:
+    """How many times the run was started or continued (headers in its log)."""
+    try:
+        return sum(1 for line in open(run_dir() / "log.txt") if line.startswith("# "))
+    except OSError:
+        return 0
+
+
+def main(argv=None) -> int:
+    global PRESET, EXTRA_SETS, RUNS, OUT
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--threads", type=int, default=2, help="solver threads (default 2; keep it for a restart)")
+    ap.add_argument("--checkpoint-every", type=float, default=600.0,
+                    help="seconds of wall time between checkpoints (default 600)")
+    ap.add_argument("--report", action="store_true", help="run nothing: report the result as it is")
+    ap.add_argument("--runs", type=pathlib.Path, default=RUNS, help=f"where the run goes (default {RUNS})")
+    ap.add_argument("--out", type=pathlib.Path, default=OUT,
+                    help=f"where paper_preset.md and out/paper_preset.png go (default {OUT})")
+    ap.add_argument("--quick", action="store_true",
+                    help="a small smoke run (tests): an 8 d x 4 d specimen at the ci preset, to Delta_a = 1 d")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="one more solver override (tests, experiments; a restart needs the same ones)")
+    a = ap.parse_args(argv)
+    RUNS, OUT = a.runs, a.out
+    if a.quick:
+        PRESET, EXTRA_SETS = "ci", {"w_s_over_d": 8, "h_s_over_d": 4, "stop_da_over_d": 1}
+    for kv in a.set:
+        key, eq, value = kv.partition("=")
+        if not eq:
+            ap.error(f"--set {kv}: expected KEY=VALUE")
+        EXTRA_SETS = {**EXTRA_SETS, key: value}
+    sys.stdout.reconfigure(line_buffering=True)
+    if not a.report:
+        if not run_bench.solver().exists():
+            print(f"paper_preset.py: solver binary {run_bench.solver()} not found: run `make build`",
+                  file=sys.stderr)
+            return 2
+        rc = run(a.threads, a.checkpoint_every)
+        if not (run_dir() / "result.h5").exists():
+            return rc
+        reported = report()   # an interrupted or failed run is reported too, and its exit status kept
+        return rc or reported
+    return report()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
