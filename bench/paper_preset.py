@@ -19,6 +19,7 @@ import argparse
 import datetime
 import math
 import pathlib
+import signal
 import subprocess
 import sys
 
@@ -72,21 +73,26 @@ def run(threads: int, checkpoint_every: float) -> int:
             return 0
     restart = (out / "checkpoint.bin").exists()
     cmd = solver_command(threads, checkpoint_every, restart)
-    with open(out / "log.txt", "a") as log:
-        log.write(f"# {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC: {' '.join(cmd)}\n")
-        log.flush()
-        print(("continuing from the checkpoint: " if restart else "") + " ".join(cmd), flush=True)
-        proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, bufsize=1)
-        while True:   # Ctrl-C reaches the solver too: it writes its checkpoint and stops; read its last lines
-            try:
-                for line in proc.stderr:
-                    sys.stderr.write(line)
-                    log.write(line)
-                    log.flush()
-                rc = proc.wait()
-                break
-            except KeyboardInterrupt:
-                continue
+    # Ctrl-C or SIGTERM: passed on to the solver (which writes its checkpoint and stops), never raised here, so
+    # every line it writes up to its exit reaches the log.
+    children = []
+    forward = lambda signum, frame: [c.send_signal(signum) for c in children]  # noqa: E731
+    previous = {s: signal.signal(s, forward) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with open(out / "log.txt", "a") as log:
+            log.write(f"# {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC: {' '.join(cmd)}\n")
+            log.flush()
+            print(("continuing from the checkpoint: " if restart else "") + " ".join(cmd), flush=True)
+            proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, bufsize=1)
+            children.append(proc)
+            for line in proc.stderr:
+                sys.stderr.write(line)
+                log.write(line)
+                log.flush()
+            rc = proc.wait()
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
     if rc != 0:
         print(f"paper_preset.py: the solver exited {rc}; run `make bench-paper` again to continue from the "
               f"last checkpoint ({out / 'checkpoint.bin'})", file=sys.stderr)

@@ -201,24 +201,65 @@ double estimateOmegaMax(Simulation& sim, const VecX& invMass) {
 
 using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// y1 = K x1 and y2 = K x2 in one pass over K (the matrix is read once for both products). Rows are
-// independent and each row sums in its stored order, so the result does not depend on the thread count.
-void multiplyTwo(const SpMatRow& K, const VecX& x1, const VecX& x2, VecX& y1, VecX& y2) {
-  const int n = static_cast<int>(K.rows());
-  y1.resize(n);
-  y2.resize(n);
-  const int* outer = K.outerIndexPtr();
-  const int* inner = K.innerIndexPtr();
-  const double* value = K.valuePtr();
-#pragma omp parallel for schedule(static)
-  for (int row = 0; row < n; ++row) {
-    double s1 = 0, s2 = 0;
-    for (int k = outer[row]; k < outer[row + 1]; ++k) {
-      s1 += value[k] * x1[inner[k]];
-      s2 += value[k] * x2[inner[k]];
+// K in 6 x 6 node blocks (block compressed rows): one column index per block instead of one per entry, and
+// the six rows of a node summed side by side. The beam stiffness is assembled from whole 12 x 12 element
+// matrices, so every stored block is full.
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as stored below
+
+struct NodeBlockMatrix {
+  int blockRows = 0;
+  std::vector<int> start;      // block row R holds blocks start[R] .. start[R + 1] - 1
+  std::vector<int> column;     // block column of each block
+  std::vector<double> value;   // block b, entry (i, j): value[36 b + 6 j + i] = K(6 R + i, 6 column[b] + j)
+};
+
+NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
+  if (K.rows() % 6 != 0) throw IntegratorError("stiffness matrix: size not a multiple of 6");
+  NodeBlockMatrix B;
+  B.blockRows = static_cast<int>(K.rows() / 6);
+  B.start.assign(1, 0);
+  for (int R = 0; R < B.blockRows; ++R) {
+    const int first = static_cast<int>(K.outerIndexPtr()[6 * R]), count = K.outerIndexPtr()[6 * R + 1] - first;
+    if (count % 6 != 0) throw IntegratorError("stiffness matrix: a row is not made of whole 6 x 6 blocks");
+    for (int k = 0; k < count; k += 6) {
+      const int c = K.innerIndexPtr()[first + k];
+      if (c % 6 != 0) throw IntegratorError("stiffness matrix: a block does not start on a node");
+      B.column.push_back(c / 6);
+      for (int j = 0; j < 6; ++j)
+        for (int i = 0; i < 6; ++i) {
+          const int row = 6 * R + i, at = K.outerIndexPtr()[row] + k + j;
+          if (K.outerIndexPtr()[row + 1] - K.outerIndexPtr()[row] != count || K.innerIndexPtr()[at] != c + j)
+            throw IntegratorError("stiffness matrix: the rows of a node do not share one block pattern");
+          B.value.push_back(K.valuePtr()[at]);
+        }
     }
-    y1[row] = s1;
-    y2[row] = s2;
+    B.start.push_back(static_cast<int>(B.column.size()));
+  }
+  return B;
+}
+
+// y1 = K x1 and y2 = K x2 in one pass over K (the matrix is read once for both products). Rows are
+// independent and each row sums its entries in ascending column order, as a compressed-row product would,
+// so the result is the same bit for bit and does not depend on the thread count.
+void multiplyTwo(const NodeBlockMatrix& K, const VecX& x1, const VecX& x2, VecX& y1, VecX& y2) {
+  y1.resize(6 * K.blockRows);
+  y2.resize(6 * K.blockRows);
+#pragma omp parallel for schedule(static)
+  for (int R = 0; R < K.blockRows; ++R) {
+    // column by column, each row's sum in ascending column order (never a partial product added at once)
+    Vec6 s1 = Vec6::Zero(), s2 = Vec6::Zero();
+    for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+      const Eigen::Map<const Mat6> block(K.value.data() + 36 * static_cast<std::size_t>(b));
+      const double* a1 = x1.data() + 6 * K.column[b];
+      const double* a2 = x2.data() + 6 * K.column[b];
+      for (int j = 0; j < 6; ++j) {
+        s1 += block.col(j) * a1[j];
+        s2 += block.col(j) * a2[j];
+      }
+    }
+    y1.segment<6>(6 * R) = s1;
+    y2.segment<6>(6 * R) = s2;
   }
 }
 
@@ -238,8 +279,7 @@ class LumpedIntegrator : public Integrator {
     const Model& m = sim.model;
     const double L = m.beamLength;
     rotaryScale_ = rotaryScaleForTranslationalLimit(sim.section, L);
-    Krow_ = sim.K;
-    Krow_.makeCompressed();
+    Kblocks_ = toNodeBlocks(SpMatRow(sim.K));
     const double mt = 0.5 * sim.section.rho * sim.section.A * L;
     const double jr = rotaryScale_ * 0.5 * sim.section.rho * sim.section.Ip * L;
     mass_ = VecX::Zero(m.numDofs());
@@ -285,7 +325,7 @@ class LumpedIntegrator : public Integrator {
     // forces at q_n (interfaces update their history here), stiffness damping at v_{n-1/2}
     fI_.resize(s.q.size());
     sim.computeForcesForInterfaces(s.q, fI_, true);
-    multiplyTwo(Krow_, s.q, s.v, Kq_, Kv_);
+    multiplyTwo(Kblocks_, s.q, s.v, Kq_, Kv_);
     vPresOld_.resize(pres.size());
     for (std::size_t i = 0; i < pres.size(); ++i) vPresOld_[i] = s.v[pres[i]];
     s.v = ((1.0 - 0.5 * a * dt) * s.v - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) / (1.0 + 0.5 * a * dt);
@@ -324,8 +364,7 @@ class LumpedIntegrator : public Integrator {
   }
 
   void onBeamsDeleted(Simulation& sim) override {  // lumped mass stays; K is already updated in sim
-    Krow_ = sim.K;
-    Krow_.makeCompressed();
+    Kblocks_ = toNodeBlocks(SpMatRow(sim.K));
   }
 
   double kineticEnergy(const Simulation& sim) const override {
@@ -335,7 +374,7 @@ class LumpedIntegrator : public Integrator {
  private:
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0;
   VecX mass_, invMass_, vPresOld_, fI_, Kq_, Kv_;
-  SpMatRow Krow_;  // sim.K in row-major order, for the fused product
+  NodeBlockMatrix Kblocks_;  // sim.K in node blocks, for the fused product
 };
 
 }  // namespace

@@ -86,3 +86,20 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
 
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and "is complete; reporting it" in r.stdout
+
+
+def test_paper_preset_passes_sigterm_on_to_the_solver(enamel, tmp_path):
+    """A SIGTERM to the script alone (a batch system stopping it) reaches the solver, which checkpoints."""
+    env = dict(os.environ, ENAMEL_BINARY=str(enamel))
+    cmd = [sys.executable, str(PAPER_PRESET), "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
+           "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
+    run = tmp_path / "runs" / "theta30_s21.4_e10_cv0"
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and not (run / "result.h5").exists():
+        time.sleep(0.2)
+    p.send_signal(signal.SIGTERM)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 12, (p.returncode, err)
+    assert (run / "checkpoint.bin").exists() and "interrupted by signal 15" in (run / "log.txt").read_text()
