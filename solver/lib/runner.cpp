@@ -131,8 +131,12 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
       if (opt.progress && (w - lastProgress > 2.0)) {
         lastProgress = w;
         const double U = s.appliedDisplacement;
-        const double frac = std::max({s.crackAdvance / p.stop_da_over_d, U / p.stop_u_over_d,
-                                      p.max_steps > 0 ? double(s.step) / p.max_steps : 0.0});
+        // ETA by proportion to the nearest stop criterion. Before the crack starts, the time to initiation is
+        // unknown and the displacement limit is usually a far safety net: only max_steps gives an ETA then.
+        const double stepFraction = p.max_steps > 0 ? double(s.step) / p.max_steps : 0.0;
+        const double frac = s.crackAdvance > 0
+                                ? std::max({s.crackAdvance / p.stop_da_over_d, U / p.stop_u_over_d, stepFraction})
+                                : stepFraction;
         const double eta = frac > 1e-3 ? w * (1 - frac) / frac : NAN;
         std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.0f steps/s  ETA %s%s",
                      tty ? "\r" : "", s.step, s.time, U, s.crackAdvance, r.J / Gamma, s.brokenBeams, s.step / w,
