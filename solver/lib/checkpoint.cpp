@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <sstream>
+#include <string>
 #include <type_traits>
 
 namespace enamel {
@@ -60,6 +62,16 @@ struct Reader {
   }
 };
 
+// The effective case without its comment lines (the source file as given, the preset, the --set options): the
+// same case given by another path, or with a --set that repeats the value it has anyway, is the same case.
+std::string effectiveKeys(const std::string& toml) {
+  std::istringstream in(toml);
+  std::string line, keys;
+  while (std::getline(in, line))
+    if (line.empty() || line[0] != '#') keys += line + "\n";
+  return keys;
+}
+
 }  // namespace
 
 void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec) {
@@ -111,7 +123,7 @@ void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
                           ", this build reads version " + std::to_string(kVersion));
   std::string toml;
   r.str(toml);
-  if (toml != sim.params.tomlText)
+  if (effectiveKeys(toml) != effectiveKeys(sim.params.tomlText))
     throw CheckpointError("checkpoint '" + path + "' was written for a different case (effective keys differ): "
                           "restart with the same case file, --preset and --set options");
   State& s = sim.state;

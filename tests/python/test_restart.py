@@ -84,7 +84,14 @@ def test_sigint_leaves_checkpoint_and_readable_partial_result(enamel, uninterrup
     with h5py.File(out / "result.h5", "r") as f:
         assert f["meta"].attrs["status"] == "interrupted"
         assert "signal" in f["meta"].attrs["stop_reason"]
-    r = subprocess.run([str(enamel), *map(str, args_for(out, "--restart"))], capture_output=True, text=True)
+    # another value is another case: refused, and the checkpoint is kept
+    r = subprocess.run([str(enamel), *map(str, args_for(out, "--restart", "--set", "zeta=0.3"))],
+                       capture_output=True, text=True)
+    assert r.returncode == EXIT_CHECKPOINT and "different case" in r.stderr, r.stderr
+    assert (out / "checkpoint.bin").exists()
+    # the same case by a relative path, with a --set that repeats a default, continues it
+    args = [a if a != CASE else CASE.relative_to(ROOT) for a in args_for(out, "--restart", "--set", "rate_factor=1.0")]
+    r = subprocess.run([str(enamel), *map(str, args)], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     a, b = curves(whole), curves(out / "result.h5")
     assert np.array_equal(a[1], b[1]) and a[4] == b[4]
