@@ -297,27 +297,36 @@ void Simulation::applyBoundaryConditions(double t) {
 void Simulation::computeForcesForInterfaces(const VecX& q, VecX& f, bool update) {
   const Model& m = model;
   const int ni = m.numInterfaces();
-  std::vector<cohesive::NodalWrench>& wrench = ifaceWrench;
-  wrench.resize(ni);
+  std::vector<cohesive::Vec3>& forceOnB = ifaceForceOnB;
+  forceOnB.resize(ni);
   int failed = 0;
 #pragma omp parallel for schedule(static) reduction(+ : failed)
   for (int i = 0; i < ni; ++i) {
     const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
     double lm = state.lambdaMax[i];
-    wrench[i] = cohesive::computeInterfaceForces(law, m.ifaceGeom[i], q.segment<3>(6 * A), q.segment<3>(6 * A + 3),
-                                                 q.segment<3>(6 * B), q.segment<3>(6 * B + 3), lm);
+    forceOnB[i] = cohesive::computeInterfaceForceOnB(law, m.ifaceGeom[i], q.segment<3>(6 * A),
+                                                     q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
+                                                     q.segment<3>(6 * B + 3), lm);
     if (update) state.lambdaMax[i] = lm;
     failed += cohesive::isFailed(law, lm);
   }
   if (update) state.failedInterfaces = failed;
-  // f_iface = -(forces exerted on the nodes), gathered per node in the fixed CSR order.
+  // f_iface = -(forces exerted on the nodes), gathered per node in the fixed CSR order; the force on A and
+  // both moments follow from the force on B (cohesive::wrenchFromForceOnB, written out for one side).
 #pragma omp parallel for schedule(static)
   for (int node = 0; node < m.numNodes(); ++node) {
     Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
     for (int k = nodeIfaceStart[node]; k < nodeIfaceStart[node + 1]; ++k) {
-      const auto& w = wrench[nodeIfaceList[k] >> 1];
-      if (nodeIfaceList[k] & 1) { F += w.forceB; Mo += w.momentB; }
-      else { F += w.forceA; Mo += w.momentA; }
+      const int i = nodeIfaceList[k] >> 1;
+      const cohesive::InterfaceGeometry& g = m.ifaceGeom[i];
+      if (nodeIfaceList[k] & 1) {
+        F += forceOnB[i];
+        Mo += g.armB.cross(forceOnB[i]);
+      } else {
+        const Vec3 forceA = -forceOnB[i];
+        F += forceA;
+        Mo += g.armA.cross(forceA);
+      }
     }
     f.segment<3>(6 * node) = -F;
     f.segment<3>(6 * node + 3) = -Mo;

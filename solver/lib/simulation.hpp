@@ -124,7 +124,7 @@ class Simulation {
   VecX reaction;                 // force applied by the grips at each prescribed DOF (last step)
   std::vector<int> lastDeleted;  // rod elements deleted in the last step
   std::string deletionRule;
-  std::vector<cohesive::NodalWrench> ifaceWrench;  // scratch: per-interface forces before the gather
+  std::vector<cohesive::Vec3> ifaceForceOnB;  // scratch: per-interface force on node B, before the gather
   std::vector<double> beamStressRatio;              // scratch: sigma / sigma_ru per rod element
 
   // --- kernels (loops over one kind of thing) ---
