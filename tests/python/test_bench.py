@@ -51,10 +51,9 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
 PAPER_PRESET = ROOT / "bench" / "paper_preset.py"
 
 
-def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
-    """`make bench-paper` in --quick mode: Ctrl-C (SIGINT to the process group, as a terminal sends it)
-    leaves a checkpoint and an 'interrupted' report and exits non-zero; the same command continues the run
-    to its end, and a third call only reports."""
+def start_paper_preset(enamel, tmp_path):
+    """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
+    terminal's process group); returns once the solver has written its first partial result."""
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
     cmd = [sys.executable, str(PAPER_PRESET), "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
            "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
@@ -64,6 +63,14 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     deadline = time.time() + 120
     while time.time() < deadline and not (run / "result.h5").exists():   # first progress write
         time.sleep(0.2)
+    return p, cmd, env, run
+
+
+def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
+    """`make bench-paper` in --quick mode: Ctrl-C (SIGINT to the process group, as a terminal sends it)
+    leaves a checkpoint and an 'interrupted' report and exits non-zero; the same command continues the run
+    to its end, and a third call only reports."""
+    p, cmd, env, run = start_paper_preset(enamel, tmp_path)
     os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 12, (p.returncode, err)   # the solver's "interrupted"
@@ -90,15 +97,7 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
 
 def test_paper_preset_passes_sigterm_on_to_the_solver(enamel, tmp_path):
     """A SIGTERM to the script alone (a batch system stopping it) reaches the solver, which checkpoints."""
-    env = dict(os.environ, ENAMEL_BINARY=str(enamel))
-    cmd = [sys.executable, str(PAPER_PRESET), "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
-           "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
-    run = tmp_path / "runs" / "theta30_s21.4_e10_cv0"
-    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True)
-    deadline = time.time() + 120
-    while time.time() < deadline and not (run / "result.h5").exists():
-        time.sleep(0.2)
+    p, _, _, run = start_paper_preset(enamel, tmp_path)
     p.send_signal(signal.SIGTERM)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 12, (p.returncode, err)
