@@ -183,7 +183,8 @@ def report() -> int:
          ("" if r.completed else " — not finished: `make bench-paper` continues it"),
          f"- crack advance reached: {r.da_max:.2f} d of {r.param('stop_da_over_d'):g} d",
          f"- wall time of the stepping: **{wall / 3600:.2f} h** ({wall:.0f} s; summed over the run's "
-         f"{max(1, _segments())} sessions, the work redone after a stop between checkpoints left out)",
+         f"{max(1, _segments())} pieces (starts and continuations), the work redone after a stop between "
+         "checkpoints left out; it counts whatever else shared the machine meanwhile)",
          f"- steps: {steps:,} (dt = {m['dt']:.4g} d/c_r); {steps / wall:.1f} steps/s; "
          f"{dof * steps / wall / threads / 1e6:.1f} M DOF-updates/s per core",
          f"- the cost-growth estimate (bench/cost_growth.csv, 200 x 200 d row at 1e-3 c_d, rescaled to this dt): "

@@ -86,7 +86,7 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     md = (tmp_path / "paper_preset.md").read_text()
     assert "status: **completed**" in md
     assert "interrupted after" in (run / "log.txt").read_text()   # the first part's last lines were logged
-    assert "2 sessions" in md
+    assert "2 pieces" in md
     assert sum(line.startswith("# ") for line in open(run / "log.txt")) == 2
     for name in ("paper_preset.png", "paper_preset.pdf"):
         assert (tmp_path / "out" / name).stat().st_size > 1000
