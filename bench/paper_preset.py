@@ -135,7 +135,8 @@ def cost_estimate_steps(r: common.Result) -> float:
 def figure(r: common.Result, reduced: dict, title: str) -> list[pathlib.Path]:
     fig, (ax, *maps) = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw=dict(width_ratios=[1.3, 1, 1, 1]),
                                    layout="constrained")
-    common.draw_rcurve(ax, r, label=f"{PRESET} preset {r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d, {VARIANT}", color="C3")
+    size = f"{r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d"
+    common.draw_rcurve(ax, r, label=f"{PRESET} preset {size}, {VARIANT}", color="C3")
     for (label, rr), color in zip(reduced.items(), ("k", "C0")):
         common.draw_rcurve(ax, rr, label=label, color=color, markersize=1.5, linewidth=0.9)
     common.draw_paper_values(ax, [v for v in common.values_for_case(CASE) if v["quantity"] == "R_ss_over_Gamma"])
