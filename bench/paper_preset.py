@@ -51,11 +51,9 @@ def run_dir() -> pathlib.Path:
 def solver_command(threads: int, checkpoint_every: float, restart: bool) -> list:
     out = run_dir()
     sets, _ = run_bench.VARIANTS[VARIANT]
-    args = run_bench.run_args(paths.case_file(CASE), PRESET, {**sets, **EXTRA_SETS}, threads, out)
-    args.remove("--quiet")   # progress lines (with an ETA) go to the terminal and the log
-    args.remove("--force")
-    args += ["--checkpoint-every", str(checkpoint_every)]
-    return args + (["--restart"] if restart else ["--force"])
+    # not --quiet: progress lines (with an ETA) go to the terminal and the log
+    flags = ["--checkpoint-every", str(checkpoint_every), "--restart" if restart else "--force"]
+    return run_bench.run_args(paths.case_file(CASE), PRESET, {**sets, **EXTRA_SETS}, threads, out, flags)
 
 
 def run(threads: int, checkpoint_every: float) -> int:
@@ -112,7 +110,7 @@ def reduced_results() -> dict:
     """{label: Result} of this case at the `reduced` size from `make bench`'s runs, where they are."""
     out = {}
     for variant in (run_bench.REFERENCE, VARIANT):
-        p = paths.BENCH_RUNS / CASE / variant.replace(" ", "_") / "result.h5"
+        p = run_bench.variant_dir(paths.BENCH_RUNS, CASE, variant) / "result.h5"
         try:
             out[f"reduced 40 d x 20 d, {variant}"] = common.load_result(p, case=CASE)
         except (common.MissingResult, OSError):

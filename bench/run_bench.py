@@ -100,8 +100,13 @@ def solver() -> pathlib.Path:
     return pathlib.Path(os.environ.get("ENAMEL_BINARY", paths.SOLVER))
 
 
-def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path) -> list:
-    a = [str(solver()), "run", str(case_file), "--preset", preset, "--out", str(out), "--force", "--quiet"]
+def variant_dir(runs: pathlib.Path, case: str, variant: str) -> pathlib.Path:
+    """Where one bench run of a case and variant goes (and is read back from)."""
+    return runs / case / variant.replace(" ", "_")
+
+
+def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path, flags=("--force", "--quiet")) -> list:
+    a = [str(solver()), "run", str(case_file), "--preset", preset, "--out", str(out), *flags]
     for k, v in {**sets, "threads": threads}.items():
         a += ["--set", f"{k}={v}"]
     return a
@@ -160,7 +165,7 @@ def speed_error_jobs(cases, variants, preset, runs: pathlib.Path, extra_sets: di
         for name, (sets, threads) in variants.items():
             if threads > 1 and case not in TWO_THREAD_CASES:
                 continue
-            out = runs / case / name.replace(" ", "_")
+            out = variant_dir(runs, case, name)
             expected = 100.0 if name == REFERENCE else 1.0 / threads
             jobs.append(Job(case=case, variant=name, cores=threads, out=out, expected_s=expected,
                             args=run_args(paths.case_file(case), preset, {**sets, **extra_sets}, threads, out)))

@@ -113,15 +113,12 @@ Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const 
   return -g.area * (g.frame.transpose() * tLocal);
 }
 
-NodalWrench wrenchFromForceOnB(const InterfaceGeometry& g, const Vec3& forceB) {
-  const Vec3 forceA = -forceB;
-  return NodalWrench{forceA, g.armA.cross(forceA), forceB, g.armB.cross(forceB)};
-}
-
 // F_B as above, F_A = -F_B, M_A = rA x F_A, M_B = rB x F_B
 NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                                    const Vec3& uB, const Vec3& thB, double& lambdaMax) {
-  return wrenchFromForceOnB(g, computeInterfaceForceOnB(law, g, uA, thA, uB, thB, lambdaMax));
+  const Vec3 forceB = computeInterfaceForceOnB(law, g, uA, thA, uB, thB, lambdaMax);
+  const Vec3 forceA = -forceB;
+  return NodalWrench{forceA, g.armA.cross(forceA), forceB, g.armB.cross(forceB)};
 }
 
 // delta = Bq with B = [-I, [rA]x, I, -[rB]x] (theta x r = -[r]x theta), q = (uA, thA, uB, thB);

@@ -72,11 +72,9 @@ struct NodalWrench { Vec3 forceA, momentA, forceB, momentB; };  // forces/moment
 NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                                    const Vec3& uB, const Vec3& thB, double& lambdaMax);
 
-// The same in two parts: the force on B alone (all an interface needs to store: the rest follows from it and
-// the arms), and the whole wrench from it.
+// The force on B alone: all an interface needs to store, since F_A = -F_B and the moments are arm x force.
 Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                               const Vec3& uB, const Vec3& thB, double& lambdaMax);
-NodalWrench wrenchFromForceOnB(const InterfaceGeometry& g, const Vec3& forceB);
 
 // Linearised (undamaged, elastic) interface stiffness 12x12 in the DOF order (uA, thA, uB, thB), k*area with
 // the rigid arms; used only to estimate frequencies / transverse modulus, never in the time loop.

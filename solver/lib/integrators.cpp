@@ -326,7 +326,8 @@ class LumpedIntegrator : public Integrator {
   std::string describe() const override {
     std::ostringstream o;
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
-      << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36 << " distinct 6x6 stiffness blocks";
+      << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36
+      << " distinct 6x6 stiffness blocks";
     return o.str();
   }
 

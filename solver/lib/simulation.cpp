@@ -312,7 +312,7 @@ void Simulation::computeForcesForInterfaces(const VecX& q, VecX& f, bool update)
   }
   if (update) state.failedInterfaces = failed;
   // f_iface = -(forces exerted on the nodes), gathered per node in the fixed CSR order; the force on A and
-  // both moments follow from the force on B (cohesive::wrenchFromForceOnB, written out for one side).
+  // both moments follow from the force on B as in cohesive::computeInterfaceForces, one side at a time.
 #pragma omp parallel for schedule(static)
   for (int node = 0; node < m.numNodes(); ++node) {
     Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
