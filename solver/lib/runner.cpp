@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -26,7 +27,31 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
   std::snprintf(buf, sizeof buf, f, a, b, c, d, e);
   return buf;
 }
+
+// "42 s", "3 h 05 min", "2.5 days".
+std::string formatDuration(double seconds) {
+  const long t = std::lround(seconds);
+  char buf[64];
+  if (t < 3600) std::snprintf(buf, sizeof buf, "%ld s", t);
+  else if (t < 86400) std::snprintf(buf, sizeof buf, "%ld h %02ld min", t / 3600, t % 3600 / 60);
+  else std::snprintf(buf, sizeof buf, "%.1f days", t / 86400.0);
+  return buf;
+}
 }  // namespace
+
+double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop) {
+  const double elapsed = now.wall - since.wall;
+  double left = NAN;
+  auto aim = [&](double from, double at, double target) {
+    if (target <= 0 || !(at > from)) return;
+    const double t = std::max(0.0, elapsed * (target - at) / (at - from));
+    left = std::isnan(left) ? t : std::min(left, t);
+  };
+  aim(since.step, now.step, stop.steps);
+  aim(since.crackAdvance, now.crackAdvance, stop.crackAdvance);
+  if (now.crackAdvance > 0) aim(since.displacement, now.displacement, stop.displacement);
+  return left;
+}
 
 void requestStop(int signal) { gStopSignal = signal; }
 
@@ -84,12 +109,20 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     rec.history.push_back(sim.measure());
   }
   save();
+  // Progress rates are measured over this piece of the run, and the crack's from where it started.
+  auto sample = [&] {
+    return ProgressSample{wall(), double(sim.state.step), sim.state.crackAdvance, sim.state.appliedDisplacement};
+  };
+  const ProgressSample pieceStart = sample();
+  ProgressSample etaSince = pieceStart;
+  const StopTargets stopTargets{p.stop_da_over_d, p.stop_u_over_d, double(p.max_steps)};
   while (true) {
     sim.step();
     if (sim.state.step == injectAt) sim.state.q[sim.freeDofs[sim.freeDofs.size() / 2]] = NAN;
     const State& s = sim.state;
     // R-curve point each time the crack advanced.
     if (s.crackAdvance > lastDa) {
+      if (lastDa == 0) etaSince = {wall(), double(s.step), 0.0, s.appliedDisplacement};
       lastDa = s.crackAdvance;
       rec.rcurveDa.push_back(s.crackAdvance);
       rec.rcurveJ.push_back(sim.computeJ());
@@ -130,18 +163,12 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
       const double w = wall();
       if (opt.progress && (w - lastProgress > 2.0)) {
         lastProgress = w;
-        const double U = s.appliedDisplacement;
-        // ETA by proportion to the nearest stop criterion. Before the crack starts, the time to initiation is
-        // unknown and the displacement limit is usually a far safety net: only max_steps gives an ETA then.
-        const double stepFraction = p.max_steps > 0 ? double(s.step) / p.max_steps : 0.0;
-        const double frac = s.crackAdvance > 0
-                                ? std::max({s.crackAdvance / p.stop_da_over_d, U / p.stop_u_over_d, stepFraction})
-                                : stepFraction;
-        const double eta = frac > 1e-3 ? w * (1 - frac) / frac : NAN;
-        std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.0f steps/s  ETA %s%s",
-                     tty ? "\r" : "", s.step, s.time, U, s.crackAdvance, r.J / Gamma, s.brokenBeams, s.step / w,
-                     std::isfinite(eta) ? (std::to_string(static_cast<long>(eta)) + " s").c_str() : "?",
-                     tty ? "   " : "\n");
+        const ProgressSample now = sample();
+        const double eta = estimateSecondsLeft(etaSince, now, stopTargets);
+        const double rate = now.wall > pieceStart.wall ? (now.step - pieceStart.step) / (now.wall - pieceStart.wall) : 0;
+        std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.1f steps/s  ETA %s%s",
+                     tty ? "\r" : "", s.step, s.time, now.displacement, s.crackAdvance, r.J / Gamma, s.brokenBeams,
+                     rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?", tty ? "   " : "\n");
       }
       if (w - lastWrite > opt.writeIntervalSeconds) save();
     }

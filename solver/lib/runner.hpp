@@ -24,6 +24,28 @@ struct RunOptions {
 /// the run completes; `restart` continues from the last one (CheckpointError when there is none).
 RunRecord runSimulation(Simulation& sim, const RunOptions& opt);
 
+/// Where a run stands, for the progress line's estimate of the time left.
+struct ProgressSample {
+  double wall = 0;          // s
+  double step = 0;
+  double crackAdvance = 0;  // d
+  double displacement = 0;  // U, d
+};
+
+/// The stop criteria the estimate aims at (a criterion <= 0 is absent).
+struct StopTargets {
+  double crackAdvance = 0;  // stop_da_over_d
+  double displacement = 0;  // stop_u_over_d
+  double steps = 0;         // max_steps
+};
+
+/// Seconds left to the nearest stop criterion, each extrapolated at the rate it progressed from `since` to
+/// `now` (pass the sample where this piece of the run, or the crack, started: the time to initiation says
+/// nothing about the crack's speed). The crack-advance criterion counts only once the crack has moved since
+/// `since`. NaN when no criterion has progressed: before the crack starts only max_steps gives an estimate,
+/// since the displacement limit is usually a far safety net.
+double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop);
+
 /// Ask a running simulation to stop at the next step (signal handlers call this).
 void requestStop(int signal);
 
