@@ -28,11 +28,12 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
   return buf;
 }
 
-// "42 s", "3 h 05 min", "2.5 days".
+// "42 s", "46 min", "3 h 05 min", "2.5 days".
 std::string formatDuration(double seconds) {
   const long t = std::lround(seconds);
   char buf[64];
-  if (t < 3600) std::snprintf(buf, sizeof buf, "%ld s", t);
+  if (t < 120) std::snprintf(buf, sizeof buf, "%ld s", t);
+  else if (t < 3600) std::snprintf(buf, sizeof buf, "%ld min", (t + 30) / 60);
   else if (t < 86400) std::snprintf(buf, sizeof buf, "%ld h %02ld min", t / 3600, t % 3600 / 60);
   else std::snprintf(buf, sizeof buf, "%.1f days", t / 86400.0);
   return buf;
