@@ -123,7 +123,10 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     const State& s = sim.state;
     // R-curve point each time the crack advanced.
     if (s.crackAdvance > lastDa) {
-      if (lastDa == 0) etaSince = {wall(), double(s.step), 0.0, s.appliedDisplacement};
+      if (lastDa == 0) {  // the crack starts: its rate is measured from here, its first advance included
+        etaSince = sample();
+        etaSince.crackAdvance = 0;
+      }
       lastDa = s.crackAdvance;
       rec.rcurveDa.push_back(s.crackAdvance);
       rec.rcurveJ.push_back(sim.computeJ());
