@@ -4,9 +4,10 @@
 #   make build    configure and build the solver and the C++ tests (Release)
 #   make test     all C++ and Python tests (runs deps and build first when needed)
 #
-#   make figures  [PRESET=ci|reduced|paper]  every run of Figs. 4-9, then the figures and the summary table
-#                 under figures/out/<preset>/ (default PRESET=reduced; use `make -j2 figures` for 2 runs at once)
-#   make runs     [PRESET=...]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
+#   make figures  [PRESET=ci|reduced|paper] [JOBS=N]  every run of Figs. 4-9, then the figures and the summary
+#                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
+#                 number of cores). A run that was stopped continues from its checkpoint.
+#   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
 #   make vtk      [PRESET=...]  ParaView files (.pvd + .vtu series) of every finished run, in runs/<preset>/<case>/vtk/
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
@@ -21,7 +22,9 @@
 
 SHELL := /bin/bash
 BUILD_DIR ?= build
-JOBS ?= 2
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+CHECKPOINT_EVERY ?= 60
+RUN_SET ?=
 
 # Debian packages: the complete set needed to build, test and draw figures.
 DEB_PACKAGES := g++ make cmake pkg-config git \
@@ -42,7 +45,8 @@ PRESETS := ci reduced paper
 RUNS := runs
 FIG_OUT := figures/out/$(PRESET)
 
-.PHONY: bench bench-paper help deps build test test-cpp test-python clean figures runs vtk reference clean-runs check-preset
+.PHONY: bench bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all vtk \
+  reference clean-runs check-preset
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -102,14 +106,23 @@ check-preset:
 	@case " $(PRESETS) " in *" $(PRESET) "*) ;; *) \
 	  echo "make: PRESET=$(PRESET) is not a preset (allowed: $(PRESETS))" >&2; exit 2;; esac
 
-# One run. A run that fails keeps its partial result readable as result.failed.h5 (and make stops, or goes on
-# with -k); result.h5 only ever holds a finished run, so the next `make` re-runs a failed one.
+# One run. The solver writes result.h5 only when the run completes (result.partial.h5 while it runs or after it
+# was stopped, result.failed.h5 when it failed), so whatever stops the pipeline (Ctrl-C, SIGTERM, SIGKILL of
+# make), the next `make` re-runs exactly the unfinished cases; --resume continues each from its checkpoint
+# (written every CHECKPOINT_EVERY s) when the case and the solver binary are unchanged, and from step 0
+# otherwise, saying which in the log (appended to, one piece after another).
+# RUN_SET="key=value ..." adds --set overrides to every run (experiments, tests; Make does not track them:
+# use another RUNS= folder for another setting).
+RUN_SETS := $(foreach s,$(RUN_SET),--set $(s))
 define run_case
 	@mkdir -p $(@D)
 	@echo "run: $(@D)"
-	@$(ENAMEL) run $< --preset $(PRESET) --out $(@D) --force $(1) 2> $(@D)/log.txt \
-	  || { rc=$$?; mv -f $@ $(@D)/result.failed.h5 2>/dev/null; tail -n 3 $(@D)/log.txt >&2; \
-	       echo "run: $(@D) failed (exit $$rc); partial result in $(@D)/result.failed.h5, log in $(@D)/log.txt" >&2; exit $$rc; }
+	@echo "== $$(date '+%F %T') make: $(ENAMEL) run $< --preset $(PRESET) $(1) $(RUN_SETS)" >> $(@D)/log.txt
+	@$(ENAMEL) run $< --preset $(PRESET) --out $(@D) --force --resume --checkpoint-every $(CHECKPOINT_EVERY) \
+	  $(1) $(RUN_SETS) 2>> $(@D)/log.txt \
+	  || { rc=$$?; tail -n 3 $(@D)/log.txt >&2; \
+	       echo "run: $(@D) stopped (exit $$rc); partial result in $(@D)/result.failed.h5 or result.partial.h5," \
+	            "log in $(@D)/log.txt" >&2; exit $$rc; }
 	@tail -n 2 $(@D)/log.txt
 endef
 
@@ -119,7 +132,15 @@ $(RUNS)/$(PRESET)/%_slow/result.h5: paper_cases/%.toml $(ENAMEL) | check-preset
 $(RUNS)/$(PRESET)/%/result.h5: paper_cases/%.toml $(ENAMEL) | check-preset
 	$(call run_case,)
 
-runs: check-preset $(ALL_RUNS)
+# `make figures` and `make runs` run JOBS cases at once (default: all cores); an outer `make -jN` is passed on.
+define parallel
+	@echo "$(1): up to $(JOBS) runs at once (JOBS=$(JOBS); set JOBS=1 for one at a time)"
+	@$(MAKE) --no-print-directory -j$(JOBS) $(1)-all
+endef
+runs: check-preset
+	$(call parallel,runs)
+
+runs-all: check-preset $(ALL_RUNS)
 
 # Figures: one script per figure (figures/figN_*.py), reading only the HDF5 results of its runs.
 fig_script = $(wildcard figures/$(1)_*.py)
@@ -135,7 +156,10 @@ FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
 	$(PYTHON) $< --preset $(PRESET)
 
-figures: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
+figures: check-preset
+	$(call parallel,figures)
+
+figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 	@test -n "$(FIGURES)" || { echo "figures: no figure list ($(BUILD_DIR)/figures.mk could not be made with PYTHON=$(PYTHON)); run 'make deps' first" >&2; exit 1; }
 	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
 

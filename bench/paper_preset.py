@@ -48,12 +48,18 @@ def run_dir() -> pathlib.Path:
     return RUNS / CASE
 
 
-def solver_command(threads: int, checkpoint_every: float, restart: bool) -> list:
+def solver_command(threads: int, checkpoint_every: float) -> list:
     out = run_dir()
     sets, _ = run_bench.VARIANTS[VARIANT]
     # not --quiet: progress lines (with an ETA) go to the terminal and the log
-    flags = ["--checkpoint-every", str(checkpoint_every), "--restart" if restart else "--force"]
+    flags = ["--checkpoint-every", str(checkpoint_every), "--force", "--resume"]
     return run_bench.run_args(paths.case_file(CASE), PRESET, {**sets, **EXTRA_SETS}, threads, out, flags)
+
+
+def result_file(out: pathlib.Path) -> pathlib.Path:
+    """The run's result: result.h5 once completed, else the partial (running, interrupted) or failed one."""
+    names = ("result.h5", "result.partial.h5", "result.failed.h5")
+    return next((out / n for n in names if (out / n).exists()), out / names[0])
 
 
 def run(threads: int, checkpoint_every: float) -> int:
@@ -70,7 +76,7 @@ def run(threads: int, checkpoint_every: float) -> int:
             print(f"paper_preset.py: {result} is complete; reporting it (delete it to run again)")
             return 0
     restart = (out / "checkpoint.bin").exists()
-    cmd = solver_command(threads, checkpoint_every, restart)
+    cmd = solver_command(threads, checkpoint_every)
     # Ctrl-C or SIGTERM: passed on to the solver (which writes its checkpoint and stops), never raised here, so
     # every line it writes up to its exit reaches the log.
     children = []
@@ -161,7 +167,7 @@ def figure(r: common.Result, reduced: dict, title: str) -> list[pathlib.Path]:
 
 
 def report() -> int:
-    h5 = run_dir() / "result.h5"
+    h5 = result_file(run_dir())
     try:
         r = common.load_result(h5, case=CASE, full=True)
     except common.MissingResult:
@@ -252,7 +258,7 @@ def main(argv=None) -> int:
                   file=sys.stderr)
             return 2
         rc = run(a.threads, a.checkpoint_every)
-        if not (run_dir() / "result.h5").exists():
+        if not result_file(run_dir()).exists():
             return rc
         reported = report()   # an interrupted or failed run is reported too, and its exit status kept
         return rc or reported

@@ -15,6 +15,7 @@
 #include "exit_codes.hpp"
 #include "geometry.hpp"
 #include "integrators.hpp"
+#include "resources.hpp"
 #include "runner.hpp"
 #include "simulation.hpp"
 #include "version.hpp"
@@ -42,8 +43,21 @@ struct CaseArgs {
   }
 };
 
-int runInfo(const CaseArgs& args) {
+// Refuse a case whose run cannot fit in this machine's memory, before anything is allocated or written.
+int checkMemory(const CaseParams& p) {
+  const std::string why = checkMemoryFits(p, availableMemoryBytes());
+  return why.empty() ? exit_code::ok : fail(exit_code::out_of_range, p.sourceName + ": " + why);
+}
+
+int runInfo(const CaseArgs& args, bool estimateOnly) {
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
+  if (estimateOnly) {  // machine-readable, without building anything (cluster job scripts use it)
+    const ResourceEstimate e = estimateResources(p);
+    std::printf("nodes %.0f\ndof %.0f\ninterfaces %.0f\nmemory_mb %.0f\n", e.nodes, e.dof, e.interfaces,
+                std::ceil(e.memoryBytes / 1048576));
+    return exit_code::ok;
+  }
+  if (int rc = checkMemory(p)) return rc;
   Simulation sim(p);
   const Model& m = sim.model;
   int byTag[4] = {0, 0, 0, 0};
@@ -71,6 +85,8 @@ int runInfo(const CaseArgs& args) {
               p.E_transverse_over_Er > 0 ? " (given)" : " (measured)");
   std::printf("damping            zeta %g at w_min %.4g: a %.4g, b %.4g\n", p.zeta, sim.omegaMin, sim.dampA, sim.dampB);
   std::printf("loading            v_app %.4g d c_r/d, ramp %.4g d/c_r\n", sim.loading.vApp, sim.loading.rampTime);
+  std::printf("memory estimate    %.0f MB (%s)\n", estimateResources(p).memoryBytes / 1048576,
+              "enamel-dem info --estimate; a run refuses a case that needs more than is available");
   return exit_code::ok;
 }
 
@@ -92,9 +108,16 @@ int prepareOutput(const std::string& dir, bool force, std::string& resultPath) {
   return exit_code::ok;
 }
 
+// A run starts (or continues): the results of earlier runs in DIR are stale. result.h5 must only ever be the
+// file of a run that completed with these inputs, so it goes now, not when this run ends.
+void removeStaleResults(const std::string& dir) {
+  std::error_code ec;
+  for (const char* status : {"completed", "failed"}) fs::remove(resultFileFor(dir, status), ec);
+}
+
 struct RunFlags {
   std::string outDir;
-  bool force = false, quiet = false, restart = false;
+  bool force = false, quiet = false, restart = false, resume = false;
   double checkpointEvery = -1;  // < 0: the case key checkpoint_interval_s
 };
 
@@ -109,7 +132,20 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   if (flags.restart && !fs::exists(checkpointPath))
     return fail(exit_code::missing_file, "--restart: no checkpoint '" + checkpointPath +
                                              "' (a run writes one every checkpoint_interval_s and on SIGINT/SIGTERM)");
-  if (int rc = prepareOutput(outDir, flags.force || flags.restart, resultPath)) return rc;
+  if (int rc = checkMemory(p)) return rc;
+  bool restart = flags.restart;
+  if (flags.resume) {  // continue when the checkpoint is this build's and this case's, else start over, saying why
+    std::string why = "no checkpoint " + checkpointPath;
+    if (fs::exists(checkpointPath)) try {
+        checkCheckpoint(checkpointPath, p);
+        restart = true;
+      } catch (const CheckpointError& e) {
+        why = e.what();
+      }
+    if (!restart) std::fprintf(stderr, "enamel-dem: starting from step 0: %s\n", why.c_str());
+  }
+  if (int rc = prepareOutput(outDir, flags.force || restart, resultPath)) return rc;
+  removeStaleResults(outDir);
   Simulation sim(p);
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
@@ -118,11 +154,11 @@ int runRun(const CaseArgs& args, RunFlags flags) {
                  p.sourceName.c_str(), sim.model.numDofs(), sim.model.numInterfaces(), sim.integrator->timeStep(),
                  sim.integrator->name().c_str(), resultPath.c_str());
   RunOptions opt;
-  opt.resultPath = resultPath;
+  opt.outDir = outDir;
   opt.progress = !flags.quiet;
   opt.checkpointPath = checkpointPath;
   opt.checkpointIntervalSeconds = flags.checkpointEvery >= 0 ? flags.checkpointEvery : p.checkpoint_interval_s;
-  opt.restart = flags.restart;
+  opt.restart = restart;
   const RunRecord rec = runSimulation(sim, opt);
   const RcurveSummary s = [&] {
     std::vector<double> R;
@@ -135,8 +171,14 @@ int runRun(const CaseArgs& args, RunFlags flags) {
                s.R_init, s.R_ss, s.daMax, sim.state.brokenBeams,
                rec.history.empty() ? 0.0 : rec.history.back().balanceError);
   for (const auto& w : rec.warnings) std::fprintf(stderr, "enamel-dem: warning: %s\n", w.c_str());
-  if (rec.status == "failed") return fail(exit_code::run_unstable, rec.stopReason + " (partial result kept in " + resultPath + ")");
-  if (rec.status == "interrupted") return exit_code::interrupted;
+  if (rec.status == "failed")
+    return fail(exit_code::run_unstable,
+                rec.stopReason + " (partial result kept in " + resultFileFor(outDir, rec.status) + ")");
+  if (rec.status == "interrupted") {
+    std::fprintf(stderr, "enamel-dem: partial result in %s; continue with --resume (or --restart)\n",
+                 resultFileFor(outDir, rec.status).c_str());
+    return exit_code::interrupted;
+  }
   return exit_code::ok;
 }
 
@@ -152,8 +194,14 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "print the model built from a case: counts of rods, nodes, beam "
                                               "elements, interfaces by tag, DOF, governing element frequency, dt");
   infoArgs.addTo(info);
+  bool estimateOnly = false;
+  info->add_flag("--estimate", estimateOnly,
+                 "print only the estimated counts and peak memory (lines 'nodes N', 'dof N', 'interfaces N', "
+                 "'memory_mb N'), without building the model");
 
-  CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5");
+  CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5 (while it "
+                                            "runs, and when interrupted: DIR/result.partial.h5; failed: "
+                                            "DIR/result.failed.h5)");
   runArgs.addTo(run);
   RunFlags flags;
   run->add_option("--out,-o", flags.outDir, "output directory (default runs/<preset>/<case name>)");
@@ -162,6 +210,9 @@ int main(int argc, char** argv) {
   run->add_flag("--restart", flags.restart,
                 "continue from DIR/checkpoint.bin (same case, --preset and --set as the first run); the result "
                 "is the same as an uninterrupted run's, bit for bit at the same thread count");
+  run->add_flag("--resume", flags.resume,
+                "continue from DIR/checkpoint.bin when it was written by this build for this case, otherwise "
+                "start from step 0 (says which on stderr): what the pipeline passes, so a killed run continues");
   run->add_option("--checkpoint-every", flags.checkpointEvery,
                   "write DIR/checkpoint.bin every this many wall-clock seconds (default: the case key "
                   "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
@@ -184,7 +235,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
-    if (*info) return runInfo(infoArgs);
+    if (*info) return runInfo(infoArgs, estimateOnly);
     if (*run) return runRun(runArgs, flags);
   } catch (const CaseError& e) {
     return fail(e.exitCode, e.what());

@@ -7,12 +7,14 @@
 #include <string>
 #include <type_traits>
 
+#include "version.hpp"
+
 namespace enamel {
 
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: the header carries the build fingerprint
 
 struct Writer {
   std::ofstream out;
@@ -72,7 +74,55 @@ std::string effectiveKeys(const std::string& toml) {
   return keys;
 }
 
+// The header: magic, format version, the build that wrote it, the effective case. Throws CheckpointError when
+// the file is not a checkpoint of this format, this build and this case.
+void readHeader(Reader& r, const std::string& caseToml) {
+  const std::string& path = r.path;
+  if (!r.in) throw CheckpointError("no checkpoint '" + path + "' to restart from");
+  char magic[8];
+  r.in.read(magic, sizeof magic);
+  if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw CheckpointError("'" + path + "' is not an enamel-dem checkpoint");
+  std::uint32_t version = 0;
+  r.pod(version);
+  if (version != kVersion)
+    throw CheckpointError("checkpoint '" + path + "' has format version " + std::to_string(version) +
+                          ", this build reads version " + std::to_string(kVersion));
+  std::string build;
+  r.str(build);
+  if (build != buildFingerprint())
+    throw CheckpointError("checkpoint '" + path + "' was written by another build of enamel-dem (" + build +
+                          "; this is " + buildFingerprint() + "): its continuation would not be bit for bit");
+  std::string toml;
+  r.str(toml);
+  if (effectiveKeys(toml) != effectiveKeys(caseToml))
+    throw CheckpointError("checkpoint '" + path + "' was written for a different case (effective keys differ): "
+                          "restart with the same case file, --preset and --set options");
+}
+
 }  // namespace
+
+const std::string& buildFingerprint() {
+  static const std::string fingerprint = [] {
+    // FNV-1a over the executable's bytes: any rebuild that changes the machine code changes it.
+    std::ifstream exe("/proc/self/exe", std::ios::binary);
+    std::uint64_t h = 1469598103934665603ULL;
+    char buf[1 << 16];
+    while (exe.read(buf, sizeof buf) || exe.gcount() > 0) {
+      for (std::streamsize i = 0; i < exe.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ULL;
+      if (!exe) break;
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return std::string(kGitHash) + " binary " + hex;
+  }();
+  return fingerprint;
+}
+
+void checkCheckpoint(const std::string& path, const CaseParams& params) {
+  Reader r{std::ifstream(path, std::ios::binary), path};
+  readHeader(r, params.tomlText);
+}
 
 void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec) {
   const std::string tmp = path + ".tmp";
@@ -81,6 +131,7 @@ void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRe
     if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "'");
     w.out.write(kMagic, sizeof kMagic);
     w.pod(kVersion);
+    w.str(buildFingerprint());
     w.str(sim.params.tomlText);
     const State& s = sim.state;
     w.pod(s.step); w.pod(s.time); w.pod(s.appliedDisplacement);
@@ -111,21 +162,7 @@ void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRe
 
 void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
   Reader r{std::ifstream(path, std::ios::binary), path};
-  if (!r.in) throw CheckpointError("no checkpoint '" + path + "' to restart from");
-  char magic[8];
-  r.in.read(magic, sizeof magic);
-  if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
-    throw CheckpointError("'" + path + "' is not an enamel-dem checkpoint");
-  std::uint32_t version = 0;
-  r.pod(version);
-  if (version != kVersion)
-    throw CheckpointError("checkpoint '" + path + "' has format version " + std::to_string(version) +
-                          ", this build reads version " + std::to_string(kVersion));
-  std::string toml;
-  r.str(toml);
-  if (effectiveKeys(toml) != effectiveKeys(sim.params.tomlText))
-    throw CheckpointError("checkpoint '" + path + "' was written for a different case (effective keys differ): "
-                          "restart with the same case file, --preset and --set options");
+  readHeader(r, sim.params.tomlText);
   State& s = sim.state;
   const Eigen::Index n = sim.model.numDofs();
   r.pod(s.step); r.pod(s.time); r.pod(s.appliedDisplacement);
@@ -153,6 +190,7 @@ void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
   r.pod(nw);
   rec.warnings.resize(nw);
   for (auto& w : rec.warnings) r.str(w);
+  char magic[8];
   r.in.read(magic, sizeof magic);
   if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
     throw CheckpointError("checkpoint '" + path + "' is truncated");

@@ -4,7 +4,8 @@
 // State (including the order in which rod elements were deleted, so that K and M are rebuilt bit for bit),
 // the reactions and the run record so far. Written whole to `path.tmp` and renamed over `path`, so a run
 // killed at any moment leaves the previous complete checkpoint. Binary, for this build only: the header
-// carries a format version and the effective case, and a mismatch is refused with a message.
+// carries a format version, the build that wrote it
+// (buildFingerprint) and the effective case, and a mismatch is refused with a message.
 #include <string>
 
 #include "output.hpp"
@@ -15,6 +16,14 @@ namespace enamel {
 struct CheckpointError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// What identifies this build in a checkpoint: the solver's git hash and a hash of the executable's bytes.
+/// A checkpoint is continued only by the build that wrote it (a rebuilt solver may round differently).
+const std::string& buildFingerprint();
+
+/// Throw CheckpointError (saying why) unless `path` is a checkpoint of this format, written by this build
+/// for this effective case: what --resume asks before it continues a run. Reads only the header.
+void checkCheckpoint(const std::string& path, const CaseParams& params);
 
 /// Write sim.state, sim.reaction and rec to `path` atomically. Throws CheckpointError naming the path.
 void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec);

@@ -35,6 +35,11 @@ Frame captureFrame(const Simulation& sim, double targetDa) {
   return f;
 }
 
+std::string resultFileFor(const std::string& dir, const std::string& status) {
+  const char* name = status == "completed" ? "result.h5" : status == "failed" ? "result.failed.h5" : "result.partial.h5";
+  return dir + "/" + name;
+}
+
 RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& R) {
   RcurveSummary s;
   if (da.empty()) return s;

@@ -43,6 +43,11 @@ struct RcurveSummary {
 };
 RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& RoverGamma);
 
+/// The result file of a run directory for a run of this status. `result.h5` exists only for a completed run
+/// (so a pipeline that counts it as done is never fooled); a run in progress or interrupted writes
+/// `result.partial.h5`, a failed one leaves `result.failed.h5`.
+std::string resultFileFor(const std::string& dir, const std::string& status);
+
 /// Write the whole result file atomically. Throws std::runtime_error naming the path on failure.
 void writeResultFile(const std::string& path, const Simulation& sim, const RunRecord& rec);
 

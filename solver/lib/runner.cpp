@@ -84,10 +84,11 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     lastCheckpoint = rec.wallSeconds;
   };
   const double minWork = kBalanceMinWork * Gamma * sim.model.B;
+  const std::string partialPath = resultFileFor(opt.outDir, "running");
   auto save = [&] {
     rec.wallSeconds = wall();
     rec.steps = sim.state.step;
-    writeResultFile(opt.resultPath, sim, rec);
+    writeResultFile(resultFileFor(opt.outDir, rec.status), sim, rec);
     lastWrite = rec.wallSeconds;
   };
   auto fail = [&](const std::string& why) {
@@ -106,6 +107,9 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     wallBefore = lastCheckpoint = rec.wallSeconds;
     lastDa = rec.rcurveDa.empty() ? 0.0 : rec.rcurveDa.back();
     nextFrame = rec.frames.size();  // frames are taken in the order of their sorted targets
+    std::fprintf(stderr, "enamel-dem: resuming from checkpoint at step %ld (U/d %.4g, da/d %.3g, %s of wall time so far)\n",
+                 sim.state.step, sim.state.appliedDisplacement, sim.state.crackAdvance,
+                 formatDuration(rec.wallSeconds).c_str());
   } else {
     rec.history.push_back(sim.measure());
   }
@@ -201,6 +205,7 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     rec.history.push_back(sim.measure());
   rec.frames.push_back(captureFrame(sim, -1.0));
   save();
+  if (resultFileFor(opt.outDir, rec.status) != partialPath) std::remove(partialPath.c_str());
   if (rec.status == "completed" && !opt.checkpointPath.empty()) std::remove(opt.checkpointPath.c_str());
   return rec;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The run loop: time steps, R-curve points, history, frames, stop criteria, quasi-static and stability
-// checks, progress on stderr, and the result file (written whole and atomically, also during the run).
+// checks, progress on stderr, and the result file (written whole and atomically, also during the run, under
+// a name that says whether the run completed).
 #include <string>
 
 #include "checkpoint.hpp"
@@ -10,7 +11,7 @@
 namespace enamel {
 
 struct RunOptions {
-  std::string resultPath;            // result.h5 to write
+  std::string outDir;                // the run directory: result files (resultFileFor) go there
   bool progress = true;              // progress lines on stderr
   double writeIntervalSeconds = 30;  // rewrite the (partial) result file this often
   std::string checkpointPath;        // checkpoint file (empty: none)
@@ -18,7 +19,9 @@ struct RunOptions {
   bool restart = false;              // continue from checkpointPath instead of starting from rest
 };
 
-/// Run to a stop criterion. Never throws for a run that goes unstable: the record's status says
+/// Run to a stop criterion. While it runs, the partial result is rewritten as DIR/result.partial.h5; at the
+/// end the result is written under the name of its status (resultFileFor: result.h5 only when completed) and
+/// the partial file removed. Never throws for a run that goes unstable: the record's status says
 /// "failed" and stopReason says which quantity, at which step, with which value. With a checkpoint path,
 /// checkpoints are written every checkpointIntervalSeconds and when a signal stops the run, and removed when
 /// the run completes; `restart` continues from the last one (CheckpointError when there is none).

@@ -61,7 +61,7 @@ def start_paper_preset(enamel, tmp_path):
     p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True)
     deadline = time.time() + 120
-    while time.time() < deadline and not (run / "result.h5").exists():   # first progress write
+    while time.time() < deadline and not (run / "result.partial.h5").exists():   # first progress write
         time.sleep(0.2)
     return p, cmd, env, run
 
@@ -77,7 +77,8 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     assert (run / "checkpoint.bin").exists()
     md = (tmp_path / "paper_preset.md").read_text()
     assert "status: **interrupted**" in md and "not finished" in md
-    steps_before = int(h5py.File(run / "result.h5")["meta"].attrs["steps"])
+    assert not (run / "result.h5").exists()   # only a completed run has one
+    steps_before = int(h5py.File(run / "result.partial.h5")["meta"].attrs["steps"])
     assert 0 < steps_before < 120000
 
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)

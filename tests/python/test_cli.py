@@ -1,6 +1,7 @@
 """Command line: --help on every command, and bad input answered by one clear line and a distinct exit
 status before anything is allocated or written (issues "Foundation" and "Hard cases and faults")."""
 import os
+import re
 import subprocess
 
 import h5py
@@ -111,14 +112,43 @@ def test_time_step_above_stable_limit_is_refused(run, tmp_path):
 
 def test_diverging_run_stops_with_readable_failed_result(enamel, tmp_path):
     """A NaN in the state (injected after step 200, as a diverging run would produce) stops the run at the next
-    check with a message naming the quantity and the step; the partial result.h5 is readable and marked failed."""
+    check with a message naming the quantity and the step; the partial result is readable as result.failed.h5 and
+    marked failed, and there is no result.h5 (which only a completed run writes)."""
     out = tmp_path / "out"
     env = dict(os.environ, ENAMEL_INJECT_NAN_AT_STEP="200")
     r = subprocess.run([str(enamel), "run", str(CASES / "small_theta0.toml"), "--out", str(out), "--quiet"],
                        capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 10, r.stderr
     assert "non-finite" in r.stderr and "step" in r.stderr
-    with h5py.File(out / "result.h5", "r") as f:
+    assert not (out / "result.h5").exists() and not (out / "result.partial.h5").exists()
+    with h5py.File(out / "result.failed.h5", "r") as f:
         assert f["meta"].attrs["status"] == "failed"
         assert "non-finite" in f["meta"].attrs["stop_reason"]
         assert f["history/step"][-1] >= 200
+
+
+@pytest.mark.parametrize("sets", [["w_s_over_d=2000", "h_s_over_d=2000"], ["h_e_over_d=1e-9"]])
+def test_case_too_large_for_memory_is_refused_before_anything_is_written(run, tmp_path, sets):
+    """A case that cannot fit is refused in one line with the memory it needs and the memory available (exit 7),
+    before the model is allocated (no bad_alloc) and before the output directory is created; `info` too."""
+    out = tmp_path / "out"
+    args = [CASES / "small_theta0.toml"] + [a for s in sets for a in ("--set", s)]
+    for cmd in (["run", *args, "--out", out], ["info", *args]):
+        r = run(*cmd, timeout=60)
+        assert r.returncode == OUT_OF_RANGE, r.stderr
+        line = r.stderr.strip()
+        assert len(line.splitlines()) == 1, line
+        assert re.search(r"needs about [0-9.e+]+ GB of memory .* and [0-9.]+ GB are available", line), line
+        assert sets[0].split("=")[0] in line
+    assert not out.exists()
+
+
+def test_info_estimate_matches_the_built_model(run):
+    """`info --estimate` (no model built) gives counts within 5% of the model `info` builds, and a memory figure."""
+    est = dict(l.split() for l in run("info", CASES / "small_theta30.toml", "--estimate").stdout.splitlines())
+    built = run("info", CASES / "small_theta30.toml").stdout
+    nodes = int(re.search(r"^nodes\s+(\d+)", built, re.M).group(1))
+    dof = int(re.search(r"^DOF\s+(\d+)", built, re.M).group(1))
+    assert abs(float(est["nodes"]) / nodes - 1) < 0.05, (est, nodes)
+    assert abs(float(est["dof"]) / dof - 1) < 0.05, (est, dof)
+    assert 10 < float(est["memory_mb"]) < 1000

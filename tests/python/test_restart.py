@@ -91,7 +91,8 @@ def test_sigint_leaves_checkpoint_and_readable_partial_result(enamel, uninterrup
     _, err = p.communicate(timeout=300)
     assert p.returncode == EXIT_INTERRUPTED, err
     assert (out / "checkpoint.bin").exists()
-    with h5py.File(out / "result.h5", "r") as f:
+    assert not (out / "result.h5").exists()   # result.h5 is only ever the file of a completed run
+    with h5py.File(out / "result.partial.h5", "r") as f:
         assert f["meta"].attrs["status"] == "interrupted"
         assert "signal" in f["meta"].attrs["stop_reason"]
     # another value is another case: refused, and the checkpoint is kept
@@ -105,6 +106,35 @@ def test_sigint_leaves_checkpoint_and_readable_partial_result(enamel, uninterrup
     assert r.returncode == 0, r.stderr
     a, b = curves(whole), curves(out / "result.h5")
     assert np.array_equal(a[1], b[1]) and a[4] == b[4]
+    assert not (out / "result.partial.h5").exists() and not (out / "checkpoint.bin").exists()
+
+
+def test_resume_continues_only_this_builds_checkpoint(enamel, uninterrupted, tmp_path):
+    """--resume (what the pipeline passes): no checkpoint -> from step 0; a checkpoint of this build and case ->
+    continued, bit for bit; one written by another build (here: the same binary with one byte appended, so its
+    fingerprint differs) -> from step 0, saying why."""
+    whole, seconds = uninterrupted
+    other = tmp_path / "other-build"
+    other.write_bytes(enamel.read_bytes() + b"\0")
+    other.chmod(0o755)
+    for binary, expect in ((other, "another build"), (enamel, "resuming from checkpoint at step")):
+        out = tmp_path / f"run-{binary.name}"
+        p = subprocess.Popen([str(binary), *map(str, args_for(out, "--checkpoint-every", "0.1"))],
+                             stderr=subprocess.PIPE, text=True)
+        deadline = time.time() + 300
+        while checkpoint_stamp(out) is None and time.time() < deadline and p.poll() is None:
+            time.sleep(0.02)
+        p.send_signal(signal.SIGINT)
+        p.communicate(timeout=300)
+        assert p.returncode == EXIT_INTERRUPTED and (out / "checkpoint.bin").exists()
+        r = subprocess.run([str(enamel), *map(str, args_for(out, "--resume"))], capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        assert expect in r.stderr, r.stderr
+        a, b = curves(whole), curves(out / "result.h5")
+        assert all(np.array_equal(x, y) for x, y in zip(a[:4], b[:4])) and a[4] == b[4]
+    r = subprocess.run([str(enamel), *map(str, args_for(tmp_path / "fresh", "--resume"))], capture_output=True,
+                       text=True)
+    assert r.returncode == 0 and "starting from step 0: no checkpoint" in r.stderr, r.stderr
 
 
 def test_bad_checkpoints_are_refused(run, tmp_path):
