@@ -17,7 +17,11 @@ CASE = "theta30_s7.1_e10_cv0"   # rods and interfaces break: deletions are repla
 SETS = "w_s_over_d=12 h_s_over_d=6 stop_da_over_d=3 threads=1"
 
 
-def make(enamel, runs, **extra):
+# a make of its own, not a sub-make of `make test` (whose command-line variables would reach it via MAKEFLAGS)
+ENV = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+
+
+def make(enamel, runs):
     target = runs / "ci" / CASE / "result.h5"
     cmd = ["make", "--no-print-directory", f"RUNS={runs}", "PRESET=ci", f"ENAMEL={enamel}", f"RUN_SET={SETS}",
            "CHECKPOINT_EVERY=0.1", str(target)]
@@ -34,12 +38,12 @@ def datasets(path):
 
 def test_make_killed_mid_run_resumes_bit_for_bit(enamel, tmp_path):
     cmd, whole = make(enamel, tmp_path / "whole")
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    r = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr
 
     cmd, target = make(enamel, tmp_path / "killed")
     run = target.parent
-    p = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    p = subprocess.Popen(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     deadline = time.time() + 300
     first = None
     while time.time() < deadline and p.poll() is None:   # wait for a checkpoint, then one more
@@ -59,7 +63,7 @@ def test_make_killed_mid_run_resumes_bit_for_bit(enamel, tmp_path):
     assert not target.exists(), "an unfinished run left result.h5"
     assert (run / "checkpoint.bin").exists()
 
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    r = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout + r.stderr
     log = (run / "log.txt").read_text()
     assert "resuming from checkpoint at step" in log, log
@@ -70,5 +74,5 @@ def test_make_killed_mid_run_resumes_bit_for_bit(enamel, tmp_path):
     different = [k for k in a[0] if not np.array_equal(a[0][k], b[0][k])]
     assert not different, different
 
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=120)   # done: nothing to run
+    r = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=120)   # done: nothing to run
     assert r.returncode == 0 and "run:" not in r.stdout, r.stdout
