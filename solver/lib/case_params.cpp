@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <variant>
@@ -19,102 +20,29 @@
 namespace enamel {
 
 // ---------------------------------------------------------------------------------------------
-// The key table: the one place where keys, defaults, ranges, units and meanings are defined.
-// Columns: name, kind, group, required, default, min, max, minOpen, maxOpen, choices, defaultText,
-// unit, doc ("short name: details").
+// The key table: ENAMEL_CASE_KEYS (case_params.hpp) as data.
 // ---------------------------------------------------------------------------------------------
+namespace {
+
+// Whether end 0 (min) or 1 (max) of `bounds` ("[]", "[)", "(]", "()") is open; any other text does not
+// compile (the table below is a constant expression).
+constexpr bool isOpenEnd(const char* bounds, int end) {
+    const bool valid = (bounds[0] == '[' || bounds[0] == '(') && (bounds[1] == ']' || bounds[1] == ')') &&
+                       bounds[2] == '\0';
+    return valid ? bounds[end] == (end == 0 ? '(' : ')')
+                 : throw std::logic_error("case_params: bounds must be one of \"[]\" \"[)\" \"(]\" \"()\"");
+}
+
+#define ENAMEL_CASE_KEY_SPEC(name, kind, group, need, default_, bounds, min, max, choices, unit, doc)       \
+    KeySpec{#name, Kind::kind, #group, Need::need == Need::required, min, max, isOpenEnd(bounds, 0),       \
+            isOpenEnd(bounds, 1), choices, unit, doc, &CaseParams::name},
+constexpr KeySpec kCaseKeys[] = {ENAMEL_CASE_KEYS(ENAMEL_CASE_KEY_SPEC)};
+#undef ENAMEL_CASE_KEY_SPEC
+
+}  // namespace
+
 const std::vector<KeySpec>& caseKeys() {
-    constexpr double kSeedMax = 2147483647.0;        // 2^31 - 1
-    constexpr double kStepsMax = 4611686018427387904.0;  // 2^62
-    constexpr bool O = true;   // open bound
-    constexpr bool C = false;  // closed bound
-    static const std::vector<KeySpec> keys = {
-        // --- physics ---
-        {"theta_D", Kind::Real, "physics", true, 0, 0, 45, C, C, "", "", "deg",
-         "decussation angle: rods at +theta_D in ply 1 and -theta_D in ply 2"},
-        {"Er_over_kd", Kind::Real, "physics", true, 0, 0.1, 1000, C, C, "", "", "E_r/(k d)",
-         "rod modulus over interface stiffness: E_r / (k d), k = interface stiffness per area"},
-        {"sigma_ru_over_sigma0", Kind::Real, "physics", true, 0, 0, 1e6, O, C, "", "", "sigma0",
-         "rod strength: mean tensile strength of a rod element / interface strength sigma0"},
-        {"cv", Kind::Real, "physics", false, 0, 0, 1, C, O, "", "", "-",
-         "strength scatter: coefficient of variation of rod-element strength (normal distribution, "
-         "negative draws redrawn)"},
-        {"Gamma_k_over_sigma0sq", Kind::Real, "physics", false, 3, 1, 1e4, C, C, "", "", "sigma0^2/k",
-         "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "
-         "fracture length)"},
-        {"delta0_over_d", Kind::Real, "physics", false, 0.1, 0, 1, O, C, "", "", "d",
-         "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "
-         "displacements, so results depend on it only through the loading rate: what is quasi-static is "
-         "(v_app/c_d) (h_s / U_c) << 1 with the initiation displacement U_c proportional to delta0 (README, Model)"},
-        {"nu_r", Kind::Real, "physics", false, 0.3, 0, 0.5, C, O, "", "", "-",
-         "rod Poisson ratio: sets the torsional stiffness G J"},
-        {"section", Kind::Choice, "physics", false, 0, 0, 0, C, C, "hexagon|circle", "hexagon", "-",
-         "rod cross-section: hexagon = space-filling hexagon of across-flats width d, circle = "
-         "circle of diameter d"},
-        {"seed", Kind::Integer, "physics", false, 1, 0, kSeedMax, C, C, "", "", "-",
-         "random seed: of the rod-element strengths (mt19937_64 + Box-Muller)"},
-        {"rods_breakable", Kind::Bool, "physics", false, 1, 0, 0, C, C, "", "", "-",
-         "rods breakable: false keeps every rod element intact"},
-        {"interfaces_breakable", Kind::Bool, "physics", false, 1, 0, 0, C, C, "", "", "-",
-         "interfaces breakable: false keeps every interface on its elastic branch"},
-        {"description", Kind::Text, "physics", false, 0, 0, 0, C, C, "", "", "-",
-         "description: free text, copied to the output"},
-        // --- numerics ---
-        {"w_s_over_d", Kind::Real, "numerics", false, 32, 2, 2000, C, C, "", "", "d",
-         "specimen width: along x, the crack growth direction"},
-        {"h_s_over_d", Kind::Real, "numerics", false, 16, 2, 2000, C, C, "", "", "d",
-         "specimen height: along y, the loading direction"},
-        {"a0_over_ws", Kind::Real, "numerics", false, 0.5, 0, 1, O, O, "", "", "w_s",
-         "pre-crack length: a0 / w_s, on the mid-plane y = h_s/2 from the left edge"},
-        {"h_e_over_d", Kind::Real, "numerics", false, 0.3, 0, 1, O, C, "", "", "d",
-         "slice spacing: distance h_e between discrete yz layers (paper: 0.3 coarse, 0.15 fine; "
-         "h_e larger than d is an error)"},
-        {"crisscross_phase", Kind::Real, "numerics", false, 0, 0, 1, C, O, "", "", "d/sin(theta_D)",
-         "crisscross phase: position of the first crisscross point ahead of the pre-crack tip, as a "
-         "fraction of the crisscross spacing d/sin(theta_D) (no effect at theta_D = 0)"},
-        {"v_app_over_cd", Kind::Real, "numerics", false, 1e-3, 0, 0.1, O, C, "", "", "c_d",
-         "loading rate: peak applied velocity at the cracked edge / transverse wave speed c_d"},
-        {"rate_factor", Kind::Real, "numerics", false, 1, 0, 1e3, O, C, "", "", "-",
-         "loading-rate multiplier: v_app = rate_factor x v_app_over_cd x c_d; the pipeline's half-rate "
-         "twins (paper: 50% slower loading) use 0.5 on top of the preset's rate"},
-        {"ramp_transits", Kind::Real, "numerics", false, 1, 0, 1e3, C, C, "", "", "h_s/c_d",
-         "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d"},
-        {"zeta", Kind::Real, "numerics", false, 0.2, 0, 1, C, C, "", "", "-",
-         "Rayleigh damping: damping ratio at w_min = pi c_d / h_s (C = a M + b K)"},
-        {"dt_factor", Kind::Real, "numerics", false, 0.1, 0, 1, O, C, "", "", "smallest element period",
-         "time step: dt / smallest element period (integrator paper; paper value 0.1)"},
-        {"integrator", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "paper|lumped", "paper", "-",
-         "integrator: paper = Newmark beta 0, consistent mass, H = M + dt/2 C factorised (reference); "
-         "lumped = explicit, lumped mass"},
-        {"damping_cap", Kind::Real, "numerics", false, 1, 0, 2, O, C, "", "", "-",
-         "stiffness damping cap (integrator lumped): b' = min(b, damping_cap / omega_max), i.e. the "
-         "stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "
-         "the stable step"},
-        {"linear_solver", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "cholmod|umfpack", "cholmod",
-         "-", "linear solver: for H = M + dt/2 C (integrator paper): CHOLMOD Cholesky or UMFPACK LU"},
-        {"deletion_rule", Kind::Choice, "numerics", false, 0, 0, 0, C, C, "most_overloaded|all",
-         "most_overloaded", "-",
-         "rod deletion rule: when several rod elements pass their strength in one step, delete the "
-         "most overloaded and re-evaluate, or delete all"},
-        {"stop_da_over_d", Kind::Real, "numerics", false, 30, 0, 1e4, O, C, "", "", "d",
-         "stop crack advance: the run stops when Delta_a reaches this"},
-        {"stop_u_over_d", Kind::Real, "numerics", false, 1e3, 0, 1e6, O, C, "", "", "d",
-         "stop displacement: the run stops when the applied displacement at the cracked edge "
-         "reaches this"},
-        {"max_steps", Kind::Integer, "numerics", false, 0, 0, kStepsMax, C, C, "", "", "steps",
-         "step limit: the run stops after this many time steps; 0 = no limit"},
-        {"history_every", Kind::Integer, "numerics", false, 0, 0, 1e9, C, C, "", "", "steps",
-         "history interval: time steps between /history output rows; 0 = automatic"},
-        {"frames_da_over_d", Kind::RealList, "numerics", false, 0, 0, 1e4, C, C, "", "[5, 15, 30]", "d",
-         "frames: crack advances Delta_a at which geometry and damage frames are written"},
-        {"E_transverse_over_Er", Kind::Real, "numerics", false, 0, 0, 10, C, C, "", "", "E_r",
-         "transverse modulus: sets c_d = sqrt(E_transverse / rho_r); 0 = measure it with a short "
-         "elastic run of the model"},
-        {"threads", Kind::Integer, "numerics", false, 0, 0, 1024, C, C, "", "", "-",
-         "threads: worker threads; 0 = automatic, one per 30k DOF up to all cores (results do not depend on it)"},
-        {"checkpoint_interval_s", Kind::Real, "numerics", false, 0, 0, 1e7, C, C, "", "", "s (wall clock)",
-         "checkpoint interval: wall-clock seconds between checkpoints; 0 = none"},
-    };
+    static const std::vector<KeySpec> keys(std::begin(kCaseKeys), std::end(kCaseKeys));
     return keys;
 }
 
@@ -152,77 +80,14 @@ std::vector<std::string> presetNames() {
 
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// Key -> CaseParams field. Checked against caseKeys() (same names, same order, matching kinds)
-// before every parse, so the struct and the table cannot drift apart silently.
-// ---------------------------------------------------------------------------------------------
-using Field = std::variant<double CaseParams::*, std::int64_t CaseParams::*, bool CaseParams::*,
-                           std::string CaseParams::*, std::vector<double> CaseParams::*>;
-struct Binding {
-    const char* name;
-    Field field;
-};
-const std::vector<Binding>& bindings() {
-    using P = CaseParams;
-    static const std::vector<Binding> b = {
-        {"theta_D", &P::theta_D},
-        {"Er_over_kd", &P::Er_over_kd},
-        {"sigma_ru_over_sigma0", &P::sigma_ru_over_sigma0},
-        {"cv", &P::cv},
-        {"Gamma_k_over_sigma0sq", &P::Gamma_k_over_sigma0sq},
-        {"delta0_over_d", &P::delta0_over_d},
-        {"nu_r", &P::nu_r},
-        {"section", &P::section},
-        {"seed", &P::seed},
-        {"rods_breakable", &P::rods_breakable},
-        {"interfaces_breakable", &P::interfaces_breakable},
-        {"description", &P::description},
-        {"w_s_over_d", &P::w_s_over_d},
-        {"h_s_over_d", &P::h_s_over_d},
-        {"a0_over_ws", &P::a0_over_ws},
-        {"h_e_over_d", &P::h_e_over_d},
-        {"crisscross_phase", &P::crisscross_phase},
-        {"v_app_over_cd", &P::v_app_over_cd},
-        {"rate_factor", &P::rate_factor},
-        {"ramp_transits", &P::ramp_transits},
-        {"zeta", &P::zeta},
-        {"dt_factor", &P::dt_factor},
-        {"integrator", &P::integrator},
-        {"damping_cap", &P::damping_cap},
-        {"linear_solver", &P::linear_solver},
-        {"deletion_rule", &P::deletion_rule},
-        {"stop_da_over_d", &P::stop_da_over_d},
-        {"stop_u_over_d", &P::stop_u_over_d},
-        {"max_steps", &P::max_steps},
-        {"history_every", &P::history_every},
-        {"frames_da_over_d", &P::frames_da_over_d},
-        {"E_transverse_over_Er", &P::E_transverse_over_Er},
-        {"threads", &P::threads},
-        {"checkpoint_interval_s", &P::checkpoint_interval_s},
-    };
-    return b;
+// The CaseParams field of key s, as the type of its kind (s.field holds a member of that type).
+template <Kind K>
+typename KeyValue<K>::type& fieldOf(CaseParams& p, const KeySpec& s) {
+    return p.*std::get<typename KeyValue<K>::type CaseParams::*>(s.field);
 }
-
-std::size_t variantIndexOf(Kind kind) {
-    switch (kind) {
-        case Kind::Real: return 0;
-        case Kind::Integer: return 1;
-        case Kind::Bool: return 2;
-        case Kind::Choice:
-        case Kind::Text: return 3;
-        case Kind::RealList: return 4;
-    }
-    return 99;
-}
-
-void checkBindings() {
-    const auto& keys = caseKeys();
-    const auto& b = bindings();
-    if (keys.size() != b.size()) throw std::logic_error("case_params: key table and CaseParams fields differ in number");
-    for (std::size_t i = 0; i < keys.size(); ++i)
-        if (std::strcmp(keys[i].name, b[i].name) != 0 || variantIndexOf(keys[i].kind) != b[i].field.index())
-            throw std::logic_error(std::string("case_params: key table and CaseParams fields differ at '") +
-                                   keys[i].name + "'");
+template <Kind K>
+const typename KeyValue<K>::type& fieldOf(const CaseParams& p, const KeySpec& s) {
+    return p.*std::get<typename KeyValue<K>::type CaseParams::*>(s.field);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -371,17 +236,29 @@ std::string formatExpected(const KeySpec& s) {
     return "";
 }
 
-std::string formatDefault(const KeySpec& s) {
-    if (s.required) return "required";
+// The value of key s in p as TOML text, each real written by formatReal: formatTomlReal in the effective
+// case ("32.0", "[5.0, 15.0, 30.0]"), formatNumber in `enamel-dem keys` ("32", "[5, 15, 30]").
+std::string formatValue(const CaseParams& p, const KeySpec& s, std::string (*formatReal)(double)) {
     switch (s.kind) {
-        case Kind::Real: return formatNumber(s.defaultValue);
-        case Kind::Integer: return formatInteger(s.defaultValue);
-        case Kind::Bool: return s.defaultValue != 0 ? "true" : "false";
-        case Kind::Choice:
-        case Kind::Text: return quote(s.defaultText);
-        case Kind::RealList: return s.defaultText;
+        case Kind::Real: return formatReal(fieldOf<Kind::Real>(p, s));
+        case Kind::Integer: return std::to_string(fieldOf<Kind::Integer>(p, s));
+        case Kind::Bool: return fieldOf<Kind::Bool>(p, s) ? "true" : "false";
+        case Kind::Choice: return quote(fieldOf<Kind::Choice>(p, s));
+        case Kind::Text: return quote(fieldOf<Kind::Text>(p, s));
+        case Kind::RealList: {
+            std::string out = "[";
+            const auto& xs = fieldOf<Kind::RealList>(p, s);
+            for (std::size_t j = 0; j < xs.size(); ++j) out += (j ? ", " : "") + formatReal(xs[j]);
+            return out + "]";
+        }
     }
     return "";
+}
+
+// The key's default as `enamel-dem keys` shows it: its value in CaseParams{}, or "required".
+std::string formatDefault(const KeySpec& s) {
+    static const CaseParams defaults;
+    return s.required ? "required" : formatValue(defaults, s, formatNumber);
 }
 
 std::string shortDoc(const KeySpec& s) {
@@ -457,8 +334,8 @@ double readReal(const std::string& src, const KeySpec& s, const toml::node& v, c
     else throwWrongType(src, s, shown);
     if (!std::isfinite(x)) throwOutOfRange(src, s, shown, "is not finite");
     if (!inInterval(s, x)) {
-        // The slice spacing is checked here and again in checkCrossKeys; say why in words.
-        const bool slicesTooFar = std::strcmp(s.name, "h_e_over_d") == 0 && x > s.maxValue;
+        // h_e larger than d: say why in words.
+        const bool slicesTooFar = s.field == KeyField(&CaseParams::h_e_over_d) && x > s.maxValue;
         throwOutOfRange(src, s, shown, slicesTooFar ? "is out of range (h_e larger than d)" : "is out of range");
     }
     return x;
@@ -480,9 +357,9 @@ toml::table parseToml(const std::string& text, const std::string& src) {
 }
 
 // Set the field of key s from the TOML value v, checking type and range.
-void applyKey(CaseParams& p, const KeySpec& s, const Field& field, const toml::node& v, const std::string& src) {
+void applyKey(CaseParams& p, const KeySpec& s, const toml::node& v, const std::string& src) {
     switch (s.kind) {
-        case Kind::Real: p.*std::get<0>(field) = readReal(src, s, v, v); break;
+        case Kind::Real: fieldOf<Kind::Real>(p, s) = readReal(src, s, v, v); break;
         case Kind::Integer: {
             auto i = v.as_integer();
             if (!i) throwWrongType(src, s, v);
@@ -490,13 +367,13 @@ void applyKey(CaseParams& p, const KeySpec& s, const Field& field, const toml::n
             const auto lo = static_cast<std::int64_t>(s.minValue), hi = static_cast<std::int64_t>(s.maxValue);
             if ((s.minOpen ? x <= lo : x < lo) || (s.maxOpen ? x >= hi : x > hi))
                 throwOutOfRange(src, s, v, "is out of range");
-            p.*std::get<1>(field) = x;
+            fieldOf<Kind::Integer>(p, s) = x;
             break;
         }
         case Kind::Bool: {
             auto b = v.as_boolean();
             if (!b) throwWrongType(src, s, v);
-            p.*std::get<2>(field) = b->get();
+            fieldOf<Kind::Bool>(p, s) = b->get();
             break;
         }
         case Kind::Choice: {
@@ -504,13 +381,13 @@ void applyKey(CaseParams& p, const KeySpec& s, const Field& field, const toml::n
             if (!str) throwWrongType(src, s, v);
             const auto c = splitChoices(s.choices);
             if (std::find(c.begin(), c.end(), str->get()) == c.end()) throwOutOfRange(src, s, v, "is not a valid choice");
-            p.*std::get<3>(field) = str->get();
+            fieldOf<Kind::Choice>(p, s) = str->get();
             break;
         }
         case Kind::Text: {
             auto str = v.as_string();
             if (!str) throwWrongType(src, s, v);
-            p.*std::get<3>(field) = str->get();
+            fieldOf<Kind::Text>(p, s) = str->get();
             break;
         }
         case Kind::RealList: {
@@ -518,7 +395,7 @@ void applyKey(CaseParams& p, const KeySpec& s, const Field& field, const toml::n
             if (!a) throwWrongType(src, s, v);
             std::vector<double> xs;
             for (const toml::node& element : *a) xs.push_back(readReal(src, s, element, v));
-            p.*std::get<4>(field) = xs;
+            fieldOf<Kind::RealList>(p, s) = xs;
             break;
         }
     }
@@ -541,27 +418,18 @@ void applyLayer(CaseParams& p, std::vector<bool>& given, const toml::table& laye
         if (numericsOnly && std::strcmp(it->group, "numerics") != 0)
             throw std::logic_error(src + ": presets may set numerics keys only, not '" + name + "'");
         const std::size_t index = static_cast<std::size_t>(it - keys.begin());
-        applyKey(p, *it, bindings()[index].field, value, src);
+        applyKey(p, *it, value, src);
         given[index] = true;
     }
 }
 
-// Key defaults as a TOML layer, so that they pass the same checks as any case file.
+// Key defaults (the optional keys' values in CaseParams{}) as a TOML layer, so that they pass the same
+// checks as any case file.
 std::string defaultsToml() {
+    const CaseParams defaults;
     std::string out;
-    for (const KeySpec& s : caseKeys()) {
-        if (s.required) continue;
-        std::string value;
-        switch (s.kind) {
-            case Kind::Real: value = formatTomlReal(s.defaultValue); break;
-            case Kind::Integer: value = formatInteger(s.defaultValue); break;
-            case Kind::Bool: value = s.defaultValue != 0 ? "true" : "false"; break;
-            case Kind::Choice:
-            case Kind::Text: value = quote(s.defaultText); break;
-            case Kind::RealList: value = s.defaultText; break;
-        }
-        out += std::string(s.name) + " = " + value + "\n";
-    }
+    for (const KeySpec& s : caseKeys())
+        if (!s.required) out += std::string(s.name) + " = " + formatValue(defaults, s, formatTomlReal) + "\n";
     return out;
 }
 
@@ -597,8 +465,6 @@ void checkCrossKeys(const CaseParams& p, const std::string& src) {
     // a0 = a0_over_ws w_s < w_s (guaranteed by the range of a0_over_ws; kept for clarity).
     if (!(p.a0() < p.w_s_over_d))
         fail("pre-crack a0 = " + formatNumber(p.a0()) + " d is not shorter than w_s = " + formatNumber(p.w_s_over_d) + " d");
-    if (p.h_e_over_d > 1)
-        fail("key 'h_e_over_d' = " + formatNumber(p.h_e_over_d) + " is out of range (h_e larger than d); allowed (0, 1] (d)");
     // Slices at x_k = k h_e for 0 <= x_k <= w_s.
     const double slices = std::floor(p.w_s_over_d / p.h_e_over_d + 1e-9) + 1;
     if (slices < 2)
@@ -625,28 +491,10 @@ std::string writeToml(const CaseParams& p, const std::vector<std::string>& sets)
     out += "# source: " + oneLine(p.sourceName) + "\n";
     out += "# preset: " + (p.presetName.empty() ? std::string("(none)") : p.presetName) + "\n";
     for (const std::string& s : sets) out += "# --set " + oneLine(s) + "\n";
-    const auto& keys = caseKeys();
     std::string group;
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-        const KeySpec& s = keys[i];
+    for (const KeySpec& s : caseKeys()) {
         if (group != s.group) out += "\n# --- " + (group = s.group) + " ---\n";
-        const Field& f = bindings()[i].field;
-        std::string value;
-        switch (s.kind) {
-            case Kind::Real: value = formatTomlReal(p.*std::get<0>(f)); break;
-            case Kind::Integer: value = std::to_string(p.*std::get<1>(f)); break;
-            case Kind::Bool: value = p.*std::get<2>(f) ? "true" : "false"; break;
-            case Kind::Choice:
-            case Kind::Text: value = quote(p.*std::get<3>(f)); break;
-            case Kind::RealList: {
-                value = "[";
-                const auto& xs = p.*std::get<4>(f);
-                for (std::size_t j = 0; j < xs.size(); ++j) value += (j ? ", " : "") + formatTomlReal(xs[j]);
-                value += "]";
-                break;
-            }
-        }
-        out += std::string(s.name) + " = " + value + "\n";
+        out += std::string(s.name) + " = " + formatValue(p, s, formatTomlReal) + "\n";
     }
     return out;
 }
@@ -669,7 +517,6 @@ std::string formatKeysMarkdown() {
 
 CaseParams parseCase(const std::string& tomlText, const std::string& sourceName, const std::string& preset,
                      const std::vector<std::string>& sets) {
-    checkBindings();
     const auto& keys = caseKeys();
 
     const Preset* chosen = nullptr;

@@ -1,5 +1,6 @@
-// Case-file parameters: the single table of keys (caseKeys), the plain struct they fill (CaseParams),
-// the built-in presets, and the parser that layers
+// Case-file parameters: the one definition of the case keys (ENAMEL_CASE_KEYS), the plain struct
+// whose fields it declares (CaseParams), the table it fills (caseKeys), the built-in presets, and the
+// parser that layers
 //     key defaults  <  preset  <  case file  <  --set key=value overrides.
 // All units are normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 (DESIGN.md 1).
 #pragma once
@@ -7,77 +8,135 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace enamel {
 
-// Kind of value a key holds, and the CaseParams field type it maps to.
-//   Real -> double, Integer -> std::int64_t, Bool -> bool, Choice -> std::string (one of `choices`),
-//   RealList -> std::vector<double>, Text -> std::string.
+// Kind of value a key holds, and the CaseParams field type it maps to (KeyValue<kind>::type).
 enum class Kind { Real, Integer, Bool, Choice, RealList, Text };
+template <Kind> struct KeyValue;
+template <> struct KeyValue<Kind::Real> { using type = double; };
+template <> struct KeyValue<Kind::Integer> { using type = std::int64_t; };
+template <> struct KeyValue<Kind::Bool> { using type = bool; };
+template <> struct KeyValue<Kind::Choice> { using type = std::string; };      // one of `choices`
+template <> struct KeyValue<Kind::RealList> { using type = std::vector<double>; };
+template <> struct KeyValue<Kind::Text> { using type = std::string; };
 
-// One case key. The table caseKeys() is the only place keys, defaults, ranges and docs are defined.
-struct KeySpec {
-    const char* name;        // TOML key, same as the CaseParams field
-    Kind kind;
-    const char* group;       // "physics" or "numerics" (presets may set numerics keys only)
-    bool required;           // no default: the case must state it
-    double defaultValue;     // Real, Integer, Bool (0/1); ignored when required
-    double minValue, maxValue;  // Real, Integer, and each element of a RealList
-    bool minOpen, maxOpen;      // true: the bound itself is not allowed
-    const char* choices;     // Choice: "a|b|c"; otherwise ""
-    const char* defaultText; // Choice, Text, RealList (a TOML array, e.g. "[5, 15, 30]"); otherwise ""
-    const char* unit;        // unit or normalisation ("deg", "d", "E_r/(k d)", ...); "-" when dimensionless or not a number
-    const char* doc;         // meaning; the text before the first ':' is the short name used in messages
-};
+// Whether a case must state the key.
+enum class Need { required, optional };
 
-const std::vector<KeySpec>& caseKeys();
-
-// Markdown table of every key: key, group, default, allowed range, unit/normalisation, meaning.
-std::string formatKeysMarkdown();
+// ---------------------------------------------------------------------------------------------
+// The case keys: the only place where a key, its field, default, range, unit and meaning are written.
+// The CaseParams fields, the parser's checks, the presets' and defaults' validation, the effective
+// case (tomlText) and `enamel-dem keys` all come from this list, in this order. One row per key:
+//   X(name, kind, group, need, default, bounds, min, max, choices, unit, doc)
+//     name      TOML key and CaseParams field
+//     kind      Real | Integer | Bool | Choice | RealList | Text (Kind)
+//     group     physics | numerics (presets may set numerics keys only)
+//     need      required (no default: the case must state it; the field starts at 0) | optional
+//     default   the field's initial value, which is the key's default
+//     bounds    "[]" "[)" "(]" "()": whether min and max themselves are allowed
+//     min, max  allowed interval of a Real, an Integer and each element of a RealList; otherwise 0, 0
+//     choices   Choice: "a|b|c"; otherwise ""
+//     unit      unit or normalisation ("deg", "d", "E_r/(k d)", ...); "-" when dimensionless or not a number
+//     doc       meaning; the text before the first ':' is the short name used in messages
+// ---------------------------------------------------------------------------------------------
+#define ENAMEL_CASE_KEYS(X)                                                                                         \
+    /* --- physics --- */                                                                                           \
+    X(theta_D, Real, physics, required, 0, "[]", 0, 45, "", "deg",                                                  \
+      "decussation angle: rods at +theta_D in ply 1 and -theta_D in ply 2")                                         \
+    X(Er_over_kd, Real, physics, required, 0, "[]", 0.1, 1000, "", "E_r/(k d)",                                     \
+      "rod modulus over interface stiffness: E_r / (k d), k = interface stiffness per area")                        \
+    X(sigma_ru_over_sigma0, Real, physics, required, 0, "(]", 0, 1e6, "", "sigma0",                                 \
+      "rod strength: mean tensile strength of a rod element / interface strength sigma0")                           \
+    X(cv, Real, physics, optional, 0, "[)", 0, 1, "", "-",                                                          \
+      "strength scatter: coefficient of variation of rod-element strength (normal distribution, "                   \
+      "negative draws redrawn)")                                                                                    \
+    X(Gamma_k_over_sigma0sq, Real, physics, optional, 3, "[]", 1, 1e4, "", "sigma0^2/k",                            \
+      "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "                        \
+      "fracture length)")                                                                                           \
+    X(delta0_over_d, Real, physics, optional, 0.1, "(]", 0, 1, "", "d",                                             \
+      "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "          \
+      "displacements, so results depend on it only through the loading rate: what is quasi-static is "              \
+      "(v_app/c_d) (h_s / U_c) << 1 with the initiation displacement U_c proportional to delta0 (README, Model)")   \
+    X(nu_r, Real, physics, optional, 0.3, "[)", 0, 0.5, "", "-",                                                    \
+      "rod Poisson ratio: sets the torsional stiffness G J")                                                        \
+    X(section, Choice, physics, optional, "hexagon", "[]", 0, 0, "hexagon|circle", "-",                             \
+      "rod cross-section: hexagon = space-filling hexagon of across-flats width d, circle = "                       \
+      "circle of diameter d")                                                                                       \
+    X(seed, Integer, physics, optional, 1, "[]", 0, 2147483647 /* 2^31 - 1 */, "", "-",                             \
+      "random seed: of the rod-element strengths (mt19937_64 + Box-Muller)")                                        \
+    X(rods_breakable, Bool, physics, optional, true, "[]", 0, 0, "", "-",                                           \
+      "rods breakable: false keeps every rod element intact")                                                       \
+    X(interfaces_breakable, Bool, physics, optional, true, "[]", 0, 0, "", "-",                                     \
+      "interfaces breakable: false keeps every interface on its elastic branch")                                    \
+    X(description, Text, physics, optional, "", "[]", 0, 0, "", "-",                                                \
+      "description: free text, copied to the output")                                                               \
+    /* --- numerics --- */                                                                                          \
+    X(w_s_over_d, Real, numerics, optional, 32, "[]", 2, 2000, "", "d",                                             \
+      "specimen width: along x, the crack growth direction")                                                        \
+    X(h_s_over_d, Real, numerics, optional, 16, "[]", 2, 2000, "", "d",                                             \
+      "specimen height: along y, the loading direction")                                                            \
+    X(a0_over_ws, Real, numerics, optional, 0.5, "()", 0, 1, "", "w_s",                                             \
+      "pre-crack length: a0 / w_s, on the mid-plane y = h_s/2 from the left edge")                                  \
+    X(h_e_over_d, Real, numerics, optional, 0.3, "(]", 0, 1, "", "d",                                               \
+      "slice spacing: distance h_e between discrete yz layers (paper: 0.3 coarse, 0.15 fine; "                      \
+      "h_e larger than d is an error)")                                                                             \
+    X(crisscross_phase, Real, numerics, optional, 0, "[)", 0, 1, "", "d/sin(theta_D)",                              \
+      "crisscross phase: position of the first crisscross point ahead of the pre-crack tip, as a "                  \
+      "fraction of the crisscross spacing d/sin(theta_D) (no effect at theta_D = 0)")                               \
+    X(v_app_over_cd, Real, numerics, optional, 1e-3, "(]", 0, 0.1, "", "c_d",                                       \
+      "loading rate: peak applied velocity at the cracked edge / transverse wave speed c_d")                        \
+    X(rate_factor, Real, numerics, optional, 1, "(]", 0, 1e3, "", "-",                                              \
+      "loading-rate multiplier: v_app = rate_factor x v_app_over_cd x c_d; the pipeline's half-rate "               \
+      "twins (paper: 50% slower loading) use 0.5 on top of the preset's rate")                                      \
+    X(ramp_transits, Real, numerics, optional, 1, "[]", 0, 1e3, "", "h_s/c_d",                                      \
+      "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d")                             \
+    X(zeta, Real, numerics, optional, 0.2, "[]", 0, 1, "", "-",                                                     \
+      "Rayleigh damping: damping ratio at w_min = pi c_d / h_s (C = a M + b K)")                                    \
+    X(dt_factor, Real, numerics, optional, 0.1, "(]", 0, 1, "", "smallest element period",                          \
+      "time step: dt / smallest element period (integrator paper; paper value 0.1)")                                \
+    X(integrator, Choice, numerics, optional, "paper", "[]", 0, 0, "paper|lumped", "-",                             \
+      "integrator: paper = Newmark beta 0, consistent mass, H = M + dt/2 C factorised (reference); "                \
+      "lumped = explicit, lumped mass")                                                                             \
+    X(damping_cap, Real, numerics, optional, 1, "(]", 0, 2, "", "-",                                                \
+      "stiffness damping cap (integrator lumped): b' = min(b, damping_cap / omega_max), i.e. the "                  \
+      "stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "           \
+      "the stable step")                                                                                            \
+    X(linear_solver, Choice, numerics, optional, "cholmod", "[]", 0, 0, "cholmod|umfpack", "-",                     \
+      "linear solver: for H = M + dt/2 C (integrator paper): CHOLMOD Cholesky or UMFPACK LU")                       \
+    X(deletion_rule, Choice, numerics, optional, "most_overloaded", "[]", 0, 0, "most_overloaded|all", "-",         \
+      "rod deletion rule: when several rod elements pass their strength in one step, delete the "                   \
+      "most overloaded and re-evaluate, or delete all")                                                             \
+    X(stop_da_over_d, Real, numerics, optional, 30, "(]", 0, 1e4, "", "d",                                          \
+      "stop crack advance: the run stops when Delta_a reaches this")                                                \
+    X(stop_u_over_d, Real, numerics, optional, 1e3, "(]", 0, 1e6, "", "d",                                          \
+      "stop displacement: the run stops when the applied displacement at the cracked edge "                         \
+      "reaches this")                                                                                               \
+    X(max_steps, Integer, numerics, optional, 0, "[]", 0, 4611686018427387904.0 /* 2^62 */, "", "steps",            \
+      "step limit: the run stops after this many time steps; 0 = no limit")                                         \
+    X(history_every, Integer, numerics, optional, 0, "[]", 0, 1e9, "", "steps",                                     \
+      "history interval: time steps between /history output rows; 0 = automatic")                                   \
+    X(frames_da_over_d, RealList, numerics, optional, (std::vector<double>{5, 15, 30}), "[]", 0, 1e4, "", "d",      \
+      "frames: crack advances Delta_a at which geometry and damage frames are written")                             \
+    X(E_transverse_over_Er, Real, numerics, optional, 0, "[]", 0, 10, "", "E_r",                                    \
+      "transverse modulus: sets c_d = sqrt(E_transverse / rho_r); 0 = measure it with a short "                     \
+      "elastic run of the model")                                                                                   \
+    X(threads, Integer, numerics, optional, 0, "[]", 0, 1024, "", "-",                                              \
+      "threads: worker threads; 0 = automatic, one per 30k DOF up to all cores (results do not depend on it)")      \
+    X(checkpoint_interval_s, Real, numerics, optional, 0, "[]", 0, 1e7, "", "s (wall clock)",                       \
+      "checkpoint interval: wall-clock seconds between checkpoints; 0 = none")
 
 // Names of the built-in presets, in order of size: "ci", "reduced", "paper".
 std::vector<std::string> presetNames();
 
-// One plain field per key of caseKeys() (same names). Filled by parseCase/loadCase only: a
-// default-constructed CaseParams holds zeros, not the key defaults.
+// One plain field per row of ENAMEL_CASE_KEYS, holding the key's default (required keys: 0) until
+// parseCase/loadCase fill it.
+// ENAMEL_CASE_FIELD declares the field of one row (tests/cpp/test_case_params.cpp uses it too).
+#define ENAMEL_CASE_FIELD(name, kind, group, need, default_, ...) KeyValue<Kind::kind>::type name = default_;
 struct CaseParams {
-    // --- physics ---
-    double theta_D = 0;                // decussation angle (deg)
-    double Er_over_kd = 0;             // E_r / (k d)
-    double sigma_ru_over_sigma0 = 0;   // mean rod strength / interface strength
-    double cv = 0;                     // coefficient of variation of rod-element strength
-    double Gamma_k_over_sigma0sq = 0;  // Gamma_i k / sigma0^2
-    double delta0_over_d = 0;          // sigma0 / (k d)
-    double nu_r = 0;                   // rod Poisson ratio
-    std::string section;               // "hexagon" | "circle"
-    std::int64_t seed = 0;             // rod-strength random seed
-    bool rods_breakable = false;
-    bool interfaces_breakable = false;
-    std::string description;
-    // --- numerics ---
-    double w_s_over_d = 0;             // specimen width (x, crack growth) / d
-    double h_s_over_d = 0;             // specimen height (y, loading) / d
-    double a0_over_ws = 0;             // pre-crack length / w_s
-    double h_e_over_d = 0;             // slice spacing / d
-    double crisscross_phase = 0;       // first crisscross point ahead of the tip, in d/sin(theta)
-    double v_app_over_cd = 0;          // peak applied velocity / c_d
-    double rate_factor = 1;            // multiplier on v_app (half-rate twins: 0.5)
-    double ramp_transits = 0;          // velocity ramp duration / (h_s/c_d)
-    double zeta = 0;                   // Rayleigh damping ratio at w_min = pi c_d / h_s
-    double dt_factor = 0;              // dt / smallest element period (integrator "paper")
-    double damping_cap = 1;            // lumped: b' omega_max at most this
-    std::string integrator;            // "paper" | "lumped"
-    std::string linear_solver;         // "cholmod" | "umfpack"
-    std::string deletion_rule;         // "most_overloaded" | "all"
-    double stop_da_over_d = 0;         // stop at this crack advance / d
-    double stop_u_over_d = 0;          // stop at this applied displacement (cracked edge) / d
-    std::int64_t max_steps = 0;        // 0 = no limit
-    std::int64_t history_every = 0;    // output step interval; 0 = automatic
-    std::vector<double> frames_da_over_d;  // crack advances / d at which frames are written
-    double E_transverse_over_Er = 0;   // 0 = measure with the model
-    std::int64_t threads = 0;          // 0 = all cores
-    double checkpoint_interval_s = 0;  // wall-clock seconds between checkpoints; 0 = none
+    ENAMEL_CASE_KEYS(ENAMEL_CASE_FIELD)
 
     // --- provenance ---
     std::string sourceName;  // case file path (or the name given to parseCase)
@@ -91,6 +150,30 @@ struct CaseParams {
     double sigma_ru() const { return sigma_ru_over_sigma0 * sigma0(); }  // mean rod strength
     double a0() const { return a0_over_ws * w_s_over_d; }          // pre-crack length
 };
+
+// The CaseParams member of a key; its alternative is KeyValue<kind>::type (Choice and Text: std::string).
+using KeyField = std::variant<double CaseParams::*, std::int64_t CaseParams::*, bool CaseParams::*,
+                              std::string CaseParams::*, std::vector<double> CaseParams::*>;
+
+// One row of ENAMEL_CASE_KEYS as data. The default is the field's value in CaseParams{}.
+struct KeySpec {
+    const char* name;
+    Kind kind;
+    const char* group;          // "physics" or "numerics"
+    bool required;
+    double minValue, maxValue;  // Real, Integer, and each element of a RealList
+    bool minOpen, maxOpen;      // true: the bound itself is not allowed
+    const char* choices;        // Choice: "a|b|c"; otherwise ""
+    const char* unit;
+    const char* doc;
+    KeyField field;
+};
+
+// Every key, in the order of ENAMEL_CASE_KEYS.
+const std::vector<KeySpec>& caseKeys();
+
+// Markdown table of every key: key, group, default, allowed range, unit/normalisation, meaning.
+std::string formatKeysMarkdown();
 
 // Error in a case (file, preset, or --set); `exitCode` is one of enamel::exit_code.
 // The message is one line naming the source, the key, the value and what is allowed.

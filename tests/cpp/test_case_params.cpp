@@ -315,45 +315,115 @@ TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
     EXPECT_EQ(paper.h_s_over_d, 200.0);
 }
 
-TEST(CaseParams, KeyTableIsComplete) {
+// A field added to CaseParams by hand, outside ENAMEL_CASE_KEYS, would be a key that no case file can set
+// and that neither the effective case nor `enamel-dem keys` shows. The key fields are declared by the
+// table itself, so the only way to make that mistake is to add a field beside the three provenance
+// strings: this fails to compile when CaseParams holds anything more than the table's fields and those.
+namespace {
+using enamel::KeyValue;
+struct TableFieldsOnly {
+    ENAMEL_CASE_KEYS(ENAMEL_CASE_FIELD)
+};
+#define COUNT_KEY(...) +1
+constexpr std::size_t kTableRows = 0 ENAMEL_CASE_KEYS(COUNT_KEY);
+#undef COUNT_KEY
+}  // namespace
+static_assert(sizeof(CaseParams) == sizeof(TableFieldsOnly) + 3 * sizeof(std::string),
+              "CaseParams has a field that is not a row of ENAMEL_CASE_KEYS (case_params.hpp): add the key there");
+
+TEST(CaseParams, KeyTableHasOneRowPerKeyWithUnitMeaningAndDefaultInRange) {
     const auto& keys = enamel::caseKeys();
+    ASSERT_EQ(keys.size(), kTableRows);
     ASSERT_GE(keys.size(), 30u);
+    const CaseParams defaults;
     std::set<std::string> names;
     for (const KeySpec& s : keys) {
         SCOPED_TRACE(s.name);
         EXPECT_TRUE(names.insert(s.name).second) << "duplicate key";
-        const std::string group = s.group, doc = s.doc, unit = s.unit;
+        const std::string group = s.group, doc = s.doc, unit = s.unit, choices = s.choices;
         EXPECT_TRUE(group == "physics" || group == "numerics");
         EXPECT_FALSE(unit.empty());
         EXPECT_GT(doc.find(':'), 0u) << "doc needs 'short name: details'";
         EXPECT_NE(doc.find(':'), std::string::npos) << "doc needs 'short name: details'";
+        EXPECT_GT(doc.size(), doc.find(':') + 2) << "doc needs details after the short name";
+        EXPECT_EQ(choices.empty(), s.kind != Kind::Choice) << "choices are for Choice keys only";
+        const bool ranged = s.kind == Kind::Real || s.kind == Kind::Integer || s.kind == Kind::RealList;
+        if (ranged) {
+            EXPECT_LT(s.minValue, s.maxValue) << "empty range";
+        } else {
+            EXPECT_TRUE(s.minValue == 0 && s.maxValue == 0 && !s.minOpen && !s.maxOpen) << "range on an unranged kind";
+        }
+        if (s.kind == Kind::Integer) {
+            EXPECT_EQ(s.minValue, std::floor(s.minValue));
+            EXPECT_EQ(s.maxValue, std::floor(s.maxValue));
+        }
         if (s.required) {
             EXPECT_EQ(group, "physics");
             continue;
         }
+        auto inRange = [&](double x) {
+            return (s.minOpen ? x > s.minValue : x >= s.minValue) && (s.maxOpen ? x < s.maxValue : x <= s.maxValue);
+        };
         switch (s.kind) {
-            case Kind::Real:
-            case Kind::Integer: {
-                const double x = s.defaultValue;
-                EXPECT_TRUE(s.minOpen ? x > s.minValue : x >= s.minValue) << "default below range";
-                EXPECT_TRUE(s.maxOpen ? x < s.maxValue : x <= s.maxValue) << "default above range";
-                if (s.kind == Kind::Integer) {
-                    EXPECT_EQ(x, std::floor(x));
-                }
+            case Kind::Real: EXPECT_TRUE(inRange(defaults.*std::get<double CaseParams::*>(s.field))); break;
+            case Kind::Integer:
+                EXPECT_TRUE(inRange(static_cast<double>(defaults.*std::get<std::int64_t CaseParams::*>(s.field))));
+                break;
+            case Kind::RealList: {
+                const auto& xs = defaults.*std::get<std::vector<double> CaseParams::*>(s.field);
+                EXPECT_FALSE(xs.empty());
+                for (const double x : xs) EXPECT_TRUE(inRange(x)) << x;
                 break;
             }
             case Kind::Choice: {
-                const std::string choices = std::string("|") + s.choices + "|";
-                EXPECT_NE(choices.find(std::string("|") + s.defaultText + "|"), std::string::npos);
+                const std::string value = defaults.*std::get<std::string CaseParams::*>(s.field);
+                EXPECT_NE(("|" + choices + "|").find("|" + value + "|"), std::string::npos) << value;
                 break;
             }
-            case Kind::RealList: EXPECT_EQ(s.defaultText[0], '['); break;
-            case Kind::Bool: EXPECT_TRUE(s.defaultValue == 0 || s.defaultValue == 1); break;
+            case Kind::Bool:
             case Kind::Text: break;
         }
     }
-    // Every default together passes the parser's own checks (lists element by element).
+    // Every default together passes the parser's own checks (the defaults are parsed as a case layer).
     EXPECT_NO_THROW(parse(""));
+}
+
+// The fuzzer's dictionary and its all-keys seed are copies of the key list made from `enamel-dem keys`:
+// they must name exactly the keys of the table (and the dictionary every choice value).
+TEST(CaseParams, FuzzDictionaryAndSeedNameEveryKey) {
+    auto readFile = [](const std::string& path) {
+        std::string text;
+        if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+            char buf[4096];
+            std::size_t n;
+            while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+            std::fclose(f);
+        }
+        return text;
+    };
+    const std::string dict = readFile(std::string(ENAMEL_SOURCE_DIR) + "/tests/fuzz/toml.dict");
+    const std::string seed = readFile(std::string(ENAMEL_SOURCE_DIR) + "/tests/fuzz/corpus/all_keys_effective.toml");
+    ASSERT_FALSE(dict.empty());
+    ASSERT_FALSE(seed.empty());
+    std::set<std::string> tableNames, dictNames;
+    for (const KeySpec& s : enamel::caseKeys()) tableNames.insert(s.name);
+    std::istringstream lines(dict);
+    std::string line;
+    while (std::getline(lines, line))
+        if (line.rfind("key_", 0) == 0) dictNames.insert(line.substr(4, line.find('=') - 4));
+    EXPECT_EQ(dictNames, tableNames);
+    for (const KeySpec& s : enamel::caseKeys()) {
+        std::istringstream choices(s.choices);
+        std::string choice;
+        while (std::getline(choices, choice, '|'))
+            EXPECT_NE(dict.find("=\"\\\"" + choice + "\\\"\"\n"), std::string::npos) << s.name << ": " << choice;
+    }
+    const CaseParams all = parseCase(seed, "all_keys_effective.toml", "", {});
+    std::set<std::string> seedNames;
+    std::istringstream seedLines(keyLines(seed));
+    while (std::getline(seedLines, line)) seedNames.insert(line.substr(0, line.find(' ')));
+    EXPECT_EQ(seedNames, tableNames);
+    EXPECT_EQ(keyLines(all.tomlText), keyLines(seed)) << "the seed is an effective case: it reads back to itself";
 }
 
 TEST(CaseParams, FormatKeysMarkdownListsEveryKey) {
