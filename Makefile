@@ -33,7 +33,9 @@ DEB_PACKAGES := g++ make cmake pkg-config git \
 
 # An interpreter that can import the pipeline's modules. The `python3` first on PATH may be a
 # pyenv one without them, so probe the Debian interpreter first; fall back to it (after
-# `make deps` it has everything).
+# `make deps` it has everything). The Python scripts run as modules from the repository root
+# (`$(PYTHON) -m figures.fig4_decussation`), so they import the package enamel_results (paths,
+# results, metrics) and each other normally; pytest gets the root from pytest.ini.
 PY_MODULES := numpy,h5py,matplotlib,meshio
 PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
     if $$p -c 'import $(PY_MODULES)' >/dev/null 2>&1; then command -v $$p; exit 0; fi; done; \
@@ -83,10 +85,10 @@ clean:
 	rm -rf $(BUILD_DIR)
 
 bench: $(ENAMEL)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) bench/run_bench.py --jobs $(JOBS)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.run_bench --jobs $(JOBS)
 
 bench-paper: $(ENAMEL)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) bench/paper_preset.py --threads $(JOBS)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.
@@ -95,8 +97,8 @@ $(ENAMEL): $(SOLVER_SOURCES) | deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target enamel-dem
 
 # Which figure uses which case: generated from paper_cases/figures.toml (FIG4_CASES, ..., ALL_CASES, ALL_SLOW).
-$(BUILD_DIR)/figures.mk: paper_cases/figures.toml pipeline/make_rules.py figures/paths.py
-	$(PYTHON) pipeline/make_rules.py $@
+$(BUILD_DIR)/figures.mk: paper_cases/figures.toml pipeline/make_rules.py enamel_results/paths.py
+	$(PYTHON) -m pipeline.make_rules $@
 -include $(BUILD_DIR)/figures.mk
 
 run_targets = $(foreach c,$(1),$(RUNS)/$(PRESET)/$(c)/result.h5) $(foreach c,$(2),$(RUNS)/$(PRESET)/$(c)_slow/result.h5)
@@ -142,19 +144,21 @@ runs: check-preset
 
 runs-all: check-preset $(ALL_RUNS)
 
-# Figures: one script per figure (figures/figN_*.py), reading only the HDF5 results of its runs.
+# Figures: one script per figure (figures/figN_*.py, run as the module figures.figN_*), reading only the HDF5
+# results of its runs; every figure depends on the plotting code, the results package and the paper's values.
 fig_script = $(wildcard figures/$(1)_*.py)
-FIG_COMMON := figures/common.py figures/paths.py figures/paper_values.toml
+fig_module = figures.$(basename $(notdir $(call fig_script,$(1))))
+FIG_COMMON := figures/plotting.py $(wildcard enamel_results/*.py) figures/paper_values.toml
 define figure_rule
 $(FIG_OUT)/$(basename $(notdir $(call fig_script,$(1)))).png: $(call fig_script,$(1)) $(FIG_COMMON) \
     $(call run_targets,$($(shell echo $(1) | tr a-z A-Z)_CASES),$($(shell echo $(1) | tr a-z A-Z)_SLOW))
-	$(PYTHON) $$< --preset $(PRESET)
+	$(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET)
 endef
 $(foreach f,$(FIGURES),$(eval $(call figure_rule,$(f))))
 FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(f)))).png)
 
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
-	$(PYTHON) $< --preset $(PRESET)
+	$(PYTHON) -m figures.summary_table --preset $(PRESET)
 
 figures: check-preset
 	$(call parallel,figures)
@@ -167,11 +171,11 @@ figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 vtk: check-preset
 	@found=0; for h in $(RUNS)/$(PRESET)/*/result.h5; do [ -f "$$h" ] || continue; found=1; \
 	  d=$$(dirname $$h)/vtk; if [ ! -d "$$d" ] || [ "$$h" -nt "$$d" ]; then \
-	    $(PYTHON) pipeline/export_vtk.py $$h $$d || exit 1; touch $$d; fi; done; \
+	    $(PYTHON) -m pipeline.export_vtk $$h $$d || exit 1; touch $$d; fi; done; \
 	if [ $$found = 0 ]; then echo "vtk: no finished runs under $(RUNS)/$(PRESET)/: run 'make runs PRESET=$(PRESET)' first" >&2; exit 1; fi
 
 reference: build
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) tests/reference/make_reference.py
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m tests.reference.make_reference
 
 clean-runs: check-preset
 	rm -rf $(RUNS)/$(PRESET) $(FIG_OUT)

@@ -23,18 +23,14 @@ import signal
 import subprocess
 import sys
 
-import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "figures"))
-sys.path.insert(0, str(ROOT / "bench"))
-import common  # noqa: E402
-import paths  # noqa: E402
-import run_bench  # noqa: E402
-
-import matplotlib  # noqa: E402
+import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from bench import run_bench  # noqa: E402
+from enamel_results import paper_values, paths, results  # noqa: E402
+from figures import plotting  # noqa: E402
 
 CASE = run_bench.CASES[0]
 VARIANT = "lumped cap0.5 dt0.22"   # the fastest within the bound without a quasi-static warning (see above)
@@ -69,7 +65,7 @@ def run(threads: int, checkpoint_every: float) -> int:
     result = out / "result.h5"
     if result.exists():
         try:
-            status = common.load_result(result, case=CASE).status
+            status = results.load_result(result, case=CASE).status
         except (OSError, KeyError):
             status = "unreadable"
         if status == "completed":
@@ -118,13 +114,13 @@ def reduced_results() -> dict:
     for variant in (run_bench.REFERENCE, VARIANT):
         p = run_bench.variant_dir(paths.BENCH_RUNS, CASE, variant) / "result.h5"
         try:
-            out[f"reduced 40 d x 20 d, {variant}"] = common.load_result(p, case=CASE)
-        except (common.MissingResult, OSError):
+            out[f"reduced 40 d x 20 d, {variant}"] = results.load_result(p, case=CASE)
+        except (results.MissingResult, OSError):
             pass
     return out
 
 
-def cost_estimate_steps(r: common.Result) -> float:
+def cost_estimate_steps(r: results.Result) -> float:
     """The cost-growth table's step estimate for the paper-preset size at the paper rate, rescaled to this
     run's dt (the table's runs use the bench's dt_factor 0.1)."""
     try:
@@ -136,15 +132,16 @@ def cost_estimate_steps(r: common.Result) -> float:
     return row["est_steps_per_run_at_1e-3"] * row["dt"] / r.meta["dt"] if row else math.nan
 
 
-def figure(r: common.Result, reduced: dict, title: str) -> list[pathlib.Path]:
+def figure(r: results.Result, reduced: dict, title: str) -> list[pathlib.Path]:
     fig, (ax, *maps) = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw=dict(width_ratios=[1.3, 1, 1, 1]),
                                    layout="constrained")
     size = f"{r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d"
-    common.draw_rcurve(ax, r, label=f"{PRESET} preset {size}, {VARIANT}", color="C3")
+    plotting.draw_rcurve(ax, r, label=f"{PRESET} preset {size}, {VARIANT}", color="C3")
     for (label, rr), color in zip(reduced.items(), ("k", "C0")):
-        common.draw_rcurve(ax, rr, label=label, color=color, markersize=1.5, linewidth=0.9)
-    common.draw_paper_values(ax, [v for v in common.values_for_case(CASE) if v["quantity"] == "R_ss_over_Gamma"])
-    common.format_rcurve_axes(ax, f"{common.case_label(r)}{common.status_flag(r)}")
+        plotting.draw_rcurve(ax, rr, label=label, color=color, markersize=1.5, linewidth=0.9)
+    stated = paper_values.values_for_case(CASE)
+    plotting.draw_paper_values(ax, [v for v in stated if v["quantity"] == "R_ss_over_Gamma"])
+    plotting.format_rcurve_axes(ax, f"{plotting.case_label(r)}{plotting.status_flag(r)}")
     ax.legend(fontsize=7, loc="lower right")
     if not r.frames:   # no frame written yet: the R-curve alone
         for axm in maps:
@@ -153,26 +150,26 @@ def figure(r: common.Result, reduced: dict, title: str) -> list[pathlib.Path]:
     frame = r.frames[-1] if r.frames else None
     a = r.geometry.attrs
     x0, yc = float(a["a0"]), float(a["y_crack_plane"])
-    for axm, (name, tag, ply) in zip(maps if frame else [], common.MAP_PANELS):
-        common.draw_process_zone(axm, r, frame, tag, ply, title=f"{name} at $\\Delta a/d$ = {frame.da:.1f}")
+    for axm, (name, tag, ply) in zip(maps if frame else [], plotting.MAP_PANELS):
+        plotting.draw_process_zone(axm, r, frame, tag, ply, title=f"{name} at $\\Delta a/d$ = {frame.da:.1f}")
         # the crack-tip region (the specimen is 200 d), within the specimen
         x_lo, x_hi = max(0.0, x0 - 5), min(float(a["w_s"]), x0 + max(35.0, frame.da + 10))
         half = 0.5 * (x_hi - x_lo)
         axm.set_xlim(x_lo, x_hi)
         axm.set_ylim(max(0.0, yc - half), min(float(a["h_s"]), yc + half))
     if frame:
-        maps[-1].legend(handles=common.map_legend_handles(), fontsize=6.5, loc="lower right")
+        maps[-1].legend(handles=plotting.map_legend_handles(), fontsize=6.5, loc="lower right")
     fig.suptitle(title, fontsize=10)
-    return common.save_to(fig, OUT / "out", "paper_preset")
+    return plotting.save_to(fig, OUT / "out", "paper_preset")
 
 
 def report() -> int:
     h5 = result_file(run_dir())
     try:
-        r = common.load_result(h5, case=CASE, full=True)
-    except common.MissingResult:
+        r = results.load_result(h5, case=CASE, full=True)
+    except results.MissingResult:
         print(f"paper_preset.py: no result {h5}: run `make bench-paper` first", file=sys.stderr)
-        return common.EXIT_MISSING
+        return results.EXIT_MISSING
     m, end = r.meta, run_bench.history_end(h5)
     reduced = reduced_results()
     row = bench_row(VARIANT)
@@ -207,9 +204,9 @@ def report() -> int:
           f"{r.broken_rods} |"]
     for label, rr in reduced.items():
         L.append(f"| {label} | {rr.R_init:.3g} | {rr.R_ss:.3g} | {rr.R_m:.3g} | {rr.da_max:.3g} | {rr.broken_rods} |")
-    for v in common.values_for_case(CASE):
+    for v in paper_values.values_for_case(CASE):
         if v["quantity"] == "R_ss_over_Gamma":
-            L.append(f"| paper (Pro & Barthelat 2020, {v['id']}) | | {common.paper_value_text(v)} | | | |")
+            L.append(f"| paper (Pro & Barthelat 2020, {v['id']}) | | {paper_values.paper_value_text(v)} | | | |")
     L += ["", "R_ss is the mean R over the last 20% of the crack advance reached and R_m the mean over "
           "0 < Delta_a/d < 30 (README, \"Solver\"), so the two sizes average different ranges.", ""]
     title = f"enamel-dem, one {PRESET}-preset case ({VARIANT}), {date}"

@@ -33,15 +33,13 @@ import time
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "figures"))
-import common  # noqa: E402
-import paths  # noqa: E402
-
-import matplotlib  # noqa: E402
+import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
+
+from enamel_results import metrics, paths, results  # noqa: E402
+from figures import plotting  # noqa: E402
 
 ERROR_BOUND = 0.02   # R-curve relative L2 difference from the reference: "within the error bound"
 PRESET = "reduced"
@@ -149,7 +147,7 @@ def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
 
 
 def history_end(result_h5) -> dict:
-    """The last /history row's applied displacement, time and energy-balance error (common.load_result
+    """The last /history row's applied displacement, time and energy-balance error (results.load_result
     reads /meta and the R-curve, not these)."""
     import h5py
     with h5py.File(result_h5, "r") as f:
@@ -179,10 +177,10 @@ def speed_error_rows(jobs: list[Job]) -> list[dict]:
         case, ref_job = j.case, reference[j.case]
         row = dict(case=case, variant=j.variant, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s)
         try:
-            r = common.load_result(j.out / "result.h5", case=case)
-            ref = common.load_result(ref_job.out / "result.h5", case=case)
+            r = results.load_result(j.out / "result.h5", case=case)
+            ref = results.load_result(ref_job.out / "result.h5", case=case)
             m = {**r.meta, **history_end(j.out / "result.h5")}
-        except (common.MissingResult, OSError, KeyError) as e:
+        except (results.MissingResult, OSError, KeyError) as e:
             row.update(status=f"no result ({e})")
             rows.append(row)
             continue
@@ -194,7 +192,7 @@ def speed_error_rows(jobs: list[Job]) -> list[dict]:
             dt_factor=r.param("dt_factor"), damping_cap=r.param("damping_cap"),
             rate_factor=r.param("rate_factor"), added_rotary_inertia=m["added_rotary_inertia"],
             speedup_wall=ref_job.wall_s / j.wall_s, speedup_cpu=ref_job.cpu_s / j.cpu_s,
-            rcurve_rel_l2=(common.rcurve_rel_l2(ref.da, ref.R, r.da, r.R)
+            rcurve_rel_l2=(metrics.rcurve_rel_l2(ref.da, ref.R, r.da, r.R)
                            if r.da.size > 1 and ref.da.size > 1 else math.nan),
             R_init=r.R_init, R_ss=r.R_ss, R_init_rel_diff=r.R_init / ref.R_init - 1,
             R_ss_rel_diff=r.R_ss / ref.R_ss - 1, da_max=r.da_max,
@@ -231,8 +229,8 @@ def cost_rows(jobs: list[Job], run_model: dict) -> list[dict]:
     for j in jobs:
         row = dict(integrator=j.variant, exit_code=j.returncode, wall_s=j.wall_s, cpu_s=j.cpu_s)
         try:
-            r = common.load_result(j.out / "result.h5")
-        except (common.MissingResult, OSError) as e:
+            r = results.load_result(j.out / "result.h5")
+        except (results.MissingResult, OSError) as e:
             row.update(status=f"no result ({e})")
             rows.append(row)
             continue
@@ -299,7 +297,7 @@ def pareto_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]
     axes[0].set_ylabel("R-curve relative L2 difference from `paper` (%)\n(reference itself drawn at 0.01%)")
     axes[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(title, fontsize=10)
-    return common.save_to(fig, out_dir, "pareto")
+    return plotting.save_to(fig, out_dir, "pareto")
 
 
 def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
@@ -340,7 +338,7 @@ def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
         ax.legend(fontsize=7, loc="upper left")
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     fig.suptitle(title, fontsize=10)
-    return common.save_to(fig, out_dir, "cost_growth")
+    return plotting.save_to(fig, out_dir, "cost_growth")
 
 
 def machine() -> str:
@@ -478,7 +476,7 @@ def main(argv=None) -> int:
         ref = next((r for r in rows if r["variant"] == REFERENCE and r.get("status") == "completed"), None)
         run_model = {}
         if ref:
-            rr = common.load_result(a.runs / ref["case"] / REFERENCE / "result.h5")
+            rr = results.load_result(a.runs / ref["case"] / REFERENCE / "result.h5")
             run_model = dict(U_end=ref["U_end"], h_s=rr.param("h_s_over_d"),
                              v_app_over_cd=rr.param("v_app_over_cd") * rr.param("rate_factor"))
         cjobs = cost_jobs(a.runs, sizes, ("lumped", "paper"), {"stop_da_over_d": 1e3} if not a.quick else {})
@@ -490,7 +488,7 @@ def main(argv=None) -> int:
                      f"`{PRESET}` rate; the `paper` preset's rate is 1e-3 c_d (x{run_model.get('v_app_over_cd', 0) / 1e-3:.2g} "
                      "more steps) and its crack goes 30 d instead of 12 d (more again): see the README.")
     ref_h5 = next((j.out / "result.h5" for j in jobs if j.variant == REFERENCE), None)
-    solver_hash = common.load_result(ref_h5).meta["git_hash"] if ref_h5 and ref_h5.exists() else "unknown"
+    solver_hash = results.load_result(ref_h5).meta["git_hash"] if ref_h5 and ref_h5.exists() else "unknown"
     header = dict(date=date, machine=machine(), git=solver_hash, preset=PRESET, jobs=a.jobs,
                   total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
     title = f"enamel-dem bench, preset {PRESET}, {header['date']}, {header['machine'].split(',')[0]}"

@@ -6,8 +6,8 @@ Delta_a/d = 15 (interfaces coloured by state, deleted rod elements in black) and
 Delta_a/d, with the half-rate twin where it was run and the paper's stated values (paper_values.toml).
 Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig4_decussation.pdf and .png.
 """
-import common
+from figures import plotting
 
 if __name__ == "__main__":
-    common.map_figure(__file__, "fig4", __doc__, ("theta_D",),
+    plotting.map_figure(__file__, "fig4", __doc__, ("theta_D",),
                       "Fig. 4: effect of the decussation angle ($\\sigma_{ru}/\\sigma_0$ = 21.4, $E_r/kd$ = 10)")

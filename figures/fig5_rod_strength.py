@@ -6,8 +6,8 @@ nearest Delta_a/d = 15 (the paper's, Fig. 5) and the R-curve R/Gamma_i against D
 of sigma_ru/sigma0 = 7.1 where it was run and the paper's stated values (paper_values.toml).
 Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig5_rod_strength.pdf and .png.
 """
-import common
+from figures import plotting
 
 if __name__ == "__main__":
-    common.map_figure(__file__, "fig5", __doc__, ("sigma_ru_over_sigma0",),
+    plotting.map_figure(__file__, "fig5", __doc__, ("sigma_ru_over_sigma0",),
                       "Fig. 5: effect of the rod strength ($\\theta_D$ = 30°, $E_r/kd$ = 10)")

@@ -14,17 +14,18 @@ import pathlib
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
-import common
+from enamel_results import cases, cli, paper_values
+from figures import plotting
 
 QUANTITIES = (("R_init", "R_init_over_Gamma", "initiation toughness $R_{init}/\\Gamma_i$"),
               ("R_ss", "R_ss_over_Gamma", "steady-state resistance $R_{ss}/\\Gamma_i$"))
 
 
 def main():
-    args = common.argument_parser(__doc__).parse_args()
-    cases = common.figure_cases("fig7")
-    results = common.load_cases(__file__, args, cases)
-    pv = common.paper_values()
+    args = cli.argument_parser(__doc__).parse_args()
+    names = cases.figure_cases("fig7")
+    results = cli.load_cases(__file__, args, names)
+    pv = paper_values.paper_values()
     rs = list(results.values())
     E_values = sorted({r.param("Er_over_kd") for r in rs})
     thetas = sorted({r.param("theta_D") for r in rs})
@@ -46,7 +47,7 @@ def main():
                     ax.plot(*zip(*bad), linestyle="", marker="o", markersize=11, markerfacecolor="none",
                             markeredgecolor="red", markeredgewidth=1.5)
                 for p in pts:
-                    for v in common.values_for_case(p[2].case, "fig7", pv):
+                    for v in paper_values.values_for_case(p[2].case, "fig7", pv):
                         if v["quantity"] == quantity:
                             ax.plot([p[0] + 0.6 * (i - 1)], [float(v["value"])], linestyle="", marker="*",
                                     markersize=12, color=f"C{i}", markeredgecolor="black")
@@ -67,11 +68,11 @@ def main():
                               markeredgecolor="red", label="run not completed"))
     fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=len(handles), fontsize=9,
                frameon=False)
-    missing = len(cases) - len(results)
+    missing = len(names) - len(results)
     fig.suptitle(f"Fig. 7: $R_{{init}}$ and $R_{{ss}}$ against $\\theta_D$, $\\sigma_{{ru}}/\\sigma_0$ and $E_r/kd$ "
                  f"(preset {args.preset}, {len(results)} runs" + (f", {missing} missing" if missing else "") + ")",
                  fontsize=11)
-    common.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
+    plotting.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
 
 
 if __name__ == "__main__":

@@ -11,19 +11,20 @@ import pathlib
 
 import matplotlib.pyplot as plt
 
-import common
+from enamel_results import cases, cli, metrics, paper_values
+from figures import plotting
 
 
 def main():
-    args = common.argument_parser(__doc__).parse_args()
-    cases = common.figure_cases("fig9")
-    results = common.load_cases(__file__, args, cases)
-    pv = common.paper_values()
+    args = cli.argument_parser(__doc__).parse_args()
+    names = cases.figure_cases("fig9")
+    results = cli.load_cases(__file__, args, names)
+    pv = paper_values.paper_values()
     by_cv = {}
     for r in results.values():
         by_cv.setdefault(r.param("cv"), []).append(r)
     cvs = sorted(by_cv)
-    pooled = {cv: common.pooled_rm(by_cv[cv]) for cv in cvs}
+    pooled = {cv: metrics.pooled_rm(by_cv[cv]) for cv in cvs}
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
     ax.errorbar(cvs, [pooled[c][0] for c in cvs], yerr=[pooled[c][1] for c in cvs], marker="o", capsize=4,
                 color="C0", label=f"{args.preset} preset: pooled $\\bar R_m \\pm \\Delta R_m$")
@@ -41,8 +42,8 @@ def main():
                 continue
             lo, hi = min(v["cv"]), max(v["cv"])
             pad = 0.02
-            lab = f"paper: {common.paper_value_text(v)} (cv = {', '.join(f'{c:g}' for c in v['cv'])})"
-            a.plot([lo - pad, hi + pad], [v["value"]] * 2, **common.PAPER_STYLE, label=lab)
+            lab = f"paper: {paper_values.paper_value_text(v)} (cv = {', '.join(f'{c:g}' for c in v['cv'])})"
+            a.plot([lo - pad, hi + pad], [v["value"]] * 2, **plotting.PAPER_STYLE, label=lab)
         a.set_xlabel("coefficient of variation of rod strength $\\Delta\\sigma_{ru}/\\bar\\sigma_{ru}$")
         a.grid(alpha=0.3)
         a.set_ylim(bottom=0)
@@ -52,7 +53,7 @@ def main():
     ax2.set_ylabel("spread $\\Delta R_m/\\Gamma_i$ (standard deviation)")
     fig.suptitle(f"Fig. 9: merged crack resistance against cv ($\\bar\\sigma_{{ru}}/\\sigma_0$ = 28.5, "
                  f"$\\theta_D$ = 30°, $E_r/kd$ = 10; preset {args.preset})", fontsize=11)
-    common.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
+    plotting.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
 
 
 if __name__ == "__main__":

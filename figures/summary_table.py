@@ -14,7 +14,7 @@ import csv
 import math
 import sys
 
-import common
+from enamel_results import cases, cli, metrics, paper_values, paths
 
 PARAMS = ("theta_D", "sigma_ru_over_sigma0", "Er_over_kd", "cv", "seed")
 OURS = (("da_max_over_d", "da_max"), ("R_init_over_Gamma", "R_init"), ("R_ss_over_Gamma", "R_ss"),
@@ -44,7 +44,7 @@ def paper_cell(values, quantity):
 
 
 def collect(args):
-    figs = common.figure_list()
+    figs = cases.figure_list()
     order, used_by = [], {}
     for fig in FIG_ORDER + tuple(k for k in figs if k not in FIG_ORDER):
         for c in figs.get(fig, {}).get("cases", []):
@@ -52,14 +52,14 @@ def collect(args):
                 order.append(c)
                 used_by[c] = []
             used_by[c].append(fig)
-    results = common.load_cases(__file__, args, order)
+    results = cli.load_cases(__file__, args, order)
     slow = [c for fig in figs.values() for c in fig.get("slow", [])]
-    slows = common.load_cases(__file__, args, list(dict.fromkeys(slow)), slow=True)
+    slows = cli.load_cases(__file__, args, list(dict.fromkeys(slow)), slow=True)
     return order, used_by, results, slows
 
 
 def make_rows(order, used_by, results, slows, pv):
-    slow_of = {f: set(e.get("slow", [])) for f, e in common.figure_list().items()}
+    slow_of = {f: set(e.get("slow", [])) for f, e in cases.figure_list().items()}
     rows = []
     entries = [(c, False) for c in order] + [(c, True) for c in order if c in slows]
     for c, is_slow in entries:
@@ -67,16 +67,16 @@ def make_rows(order, used_by, results, slows, pv):
         figs = [f for f in used_by[c] if not is_slow or c in slow_of[f]]
         row = dict(case=c + ("_slow" if is_slow else ""), figures=" ".join(figs),
                    loading="half rate" if is_slow else "preset")
-        params = r.params if r else common.params_from_name(c)
+        params = r.params if r else cases.params_from_name(c)
         for k in PARAMS:
             row[k] = num(params.get(k), "%g") if isinstance(params.get(k), float) else num(params.get(k))
         row["status"] = r.status if r else "missing"
         for col, attr in OURS:
             row[col] = num(getattr(r, attr)) if r else ""
         if not is_slow:
-            vals = common.values_for_case(c, pv=pv)
+            vals = paper_values.values_for_case(c, pv=pv)
             if {"fig8", "fig9"} & set(used_by[c]):  # the pooled Fig. 9 values belong to the realisations
-                vals += common.values_for_cv(float(params.get("cv", 0.0)), pv=pv)
+                vals += paper_values.values_for_cv(float(params.get("cv", 0.0)), pv=pv)
             for q in PAPER:
                 row[f"paper_{q}"] = paper_cell(vals, q)
         rows.append(row)
@@ -123,7 +123,7 @@ def check_trends(results, pv):
                 by_cv.setdefault(r.param("cv"), []).append(r)
             pts = []
             for cv in sorted(by_cv):
-                m, s, _ = common.pooled_rm(by_cv[cv])
+                m, s, _ = metrics.pooled_rm(by_cv[cv])
                 pts.append((cv, m if q.startswith("R_m") else s))
             series.append(("pooled per cv", pts, series_verdict(t["direction"], [p[1] for p in pts])))
         else:
@@ -166,7 +166,7 @@ def write_markdown(path, preset, rows, results, pv, trends):
         row = dict(row, status=st if st == "completed" else f"**{st}**")
         lines.append("| " + " | ".join(fmt(c, row.get(c, "")) for c in short) + " |")
     # pooled R_m per cv (Fig. 9)
-    fig9 = [c for c in common.figure_cases("fig9") if c in results]
+    fig9 = [c for c in cases.figure_cases("fig9") if c in results]
     by_cv = {}
     for c in fig9:
         by_cv.setdefault(results[c].param("cv"), []).append(results[c])
@@ -175,9 +175,9 @@ def write_markdown(path, preset, rows, results, pv, trends):
                   "| cv | realisations | R̄_m/Γ | ΔR_m/Γ | points | paper R̄_m/Γ | paper ΔR_m/Γ |",
                   "|---|---|---|---|---|---|---|"]
         for cv in sorted(by_cv):
-            m, s, n = common.pooled_rm(by_cv[cv])
-            pm = paper_cell(common.values_for_cv(cv, pv=pv), "R_m_pooled_over_Gamma")
-            ps = paper_cell(common.values_for_cv(cv, pv=pv), "dR_m_pooled_over_Gamma")
+            m, s, n = metrics.pooled_rm(by_cv[cv])
+            pm = paper_cell(paper_values.values_for_cv(cv, pv=pv), "R_m_pooled_over_Gamma")
+            ps = paper_cell(paper_values.values_for_cv(cv, pv=pv), "dR_m_pooled_over_Gamma")
             lines.append(f"| {cv:g} | {len(by_cv[cv])} | {m:.4g} | {s:.4g} | {n} | {pm} | {ps} |")
     lines += ["", "## Trends the paper states, checked on these runs", "",
               f"('constant': max - min within {CONSTANT_RTOL:.0%} of the mean; each combination of the parameters "
@@ -194,11 +194,11 @@ def write_markdown(path, preset, rows, results, pv, trends):
 
 
 def main():
-    args = common.argument_parser(__doc__).parse_args()
-    pv = common.paper_values()
+    args = cli.argument_parser(__doc__).parse_args()
+    pv = paper_values.paper_values()
     order, used_by, results, slows = collect(args)
     rows = make_rows(order, used_by, results, slows, pv)
-    d = common.paths.figure_dir(args.preset, args.out)
+    d = paths.figure_dir(args.preset, args.out)
     d.mkdir(parents=True, exist_ok=True)
     with open(d / "summary.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=COLUMNS)

@@ -25,12 +25,10 @@ import pathlib
 import sys
 from xml.sax.saxutils import quoteattr
 
+import meshio
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "figures"))
-import common  # noqa: E402
-
-import meshio  # noqa: E402
+from enamel_results.results import EXIT_MISSING, MissingResult, load_result
 
 
 # --- rod stress: the solver's check (solver/lib/beam.cpp maxTensileStress), vectorised over elements ---
@@ -117,7 +115,7 @@ def add_nodes_per_element(path: pathlib.Path) -> None:
 
 
 def export(result_path, outdir, fmt: str = "vtu") -> dict:
-    r = common.load_result(result_path, full=True)
+    r = load_result(result_path, full=True)
     g = r.geometry
     outdir = pathlib.Path(outdir).resolve()
     outdir.mkdir(parents=True, exist_ok=True)
@@ -193,10 +191,10 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     try:
         info = export(args.result, args.outdir, args.format)
-    except common.MissingResult as e:
+    except MissingResult as e:
         print(f"export_vtk.py: missing result file {e.path}: run the case first "
               f"(`enamel-dem run CASE.toml` or `make runs PRESET=...`)", file=sys.stderr)
-        return common.EXIT_MISSING
+        return EXIT_MISSING
     for fpath in info["files"]:
         print(fpath)
     print(f"{info['frames']} frames, {info['beams']} rod elements, {info['interfaces']} interfaces",

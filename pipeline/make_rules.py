@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the Make variables of the figure set from paper_cases/figures.toml (standard library only).
 
-    make_rules.py OUT.mk
+    python3 -m pipeline.make_rules OUT.mk     (from the repository root)
 
 For every figure FIG (fig4 ... fig9): FIG_CASES (its cases) and FIG_SLOW (cases that also run at half the
 preset's loading rate). ALL_CASES and ALL_SLOW are the unique unions: a case shared by several figures runs once.
@@ -12,9 +12,7 @@ import pathlib
 import sys
 import tomllib
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "figures"))
-import paths  # noqa: E402  (the one place that defines paths)
+from enamel_results import paths  # the one place that defines paths (standard library only)
 
 
 def main():

@@ -1,4 +1,5 @@
-"""Shared fixtures: the solver binary (ENAMEL_BINARY, set by `make test`) and the small test cases."""
+"""Shared fixtures: the solver binary (ENAMEL_BINARY, set by `make test`), the small test cases, and the runs
+that several modules read, each made once per session (ci_run, tiny_run)."""
 import os
 import pathlib
 import subprocess
@@ -7,6 +8,9 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 CASES = ROOT / "tests" / "cases"
+PAPER_CASES = ROOT / "paper_cases"
+# A tiny variant of the ci preset (8 d x 4 d, stopped at Delta_a/d = 1.5, two frames; 2-10 s a case).
+TINY_SETS = ["w_s_over_d=8", "h_s_over_d=4", "stop_da_over_d=1.5", "frames_da_over_d=[0.5, 1.5]"]
 
 
 @pytest.fixture(scope="session")
@@ -24,3 +28,37 @@ def run(enamel):
     def _run(*args, timeout=600):
         return subprocess.run([str(enamel), *map(str, args)], capture_output=True, text=True, timeout=timeout)
     return _run
+
+
+class SessionRuns:
+    """Runs of paper cases at the ci preset (with `sets` on top), each made the first time a test asks for it and
+    shared by every module after: runs(case) -> ROOT_DIR/ci/<case>/result.h5 (the layout of runs/, so figure
+    scripts read them with --runs ROOT_DIR --preset ci)."""
+
+    def __init__(self, run, root: pathlib.Path, sets: list):
+        self.run, self.root, self.sets, self.made = run, root, sets, {}
+
+    def __call__(self, case: str) -> pathlib.Path:
+        if case not in self.made:
+            out = self.root / "ci" / case
+            args = ["run", PAPER_CASES / f"{case}.toml", "--preset", "ci", "--out", out, "--quiet"]
+            for s in self.sets:
+                args += ["--set", s]
+            r = self.run(*args, timeout=900)
+            assert r.returncode == 0, f"{case}: exit {r.returncode}\n{r.stderr}"
+            self.made[case] = out / "result.h5"
+        return self.made[case]
+
+
+@pytest.fixture(scope="session")
+def ci_run(run, tmp_path_factory):
+    """ci_run(case): the paper case at the ci preset, run once per session (the reference, reference-solver and
+    hard-case tests share theta0_s21.4_e10_cv0 and theta30_s21.4_e10_cv0)."""
+    return SessionRuns(run, tmp_path_factory.mktemp("ci_runs"), [])
+
+
+@pytest.fixture(scope="session")
+def tiny_run(run, tmp_path_factory):
+    """tiny_run(case): the paper case at the tiny ci variant TINY_SETS, run once per session (figures and VTK
+    export tests); tiny_run.root is the runs/ root of all of them."""
+    return SessionRuns(run, tmp_path_factory.mktemp("tiny_runs"), TINY_SETS)

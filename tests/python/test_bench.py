@@ -15,14 +15,13 @@ import h5py
 
 from conftest import ROOT
 
-PYTHON_BENCH = ROOT / "bench" / "run_bench.py"
 
 
 def test_quick_bench_writes_its_report(enamel, tmp_path):
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
-    r = subprocess.run([sys.executable, str(PYTHON_BENCH), "--quick", "--out",
+    r = subprocess.run([sys.executable, "-m", "bench.run_bench", "--quick", "--out",
                         str(tmp_path), "--runs", str(tmp_path / "runs")], capture_output=True, text=True, env=env,
-                       timeout=600)
+                       timeout=600, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(open(tmp_path / "results.csv")))
     assert [row["variant"] for row in rows] == ["paper", "lumped", "lumped rate2"]
@@ -48,18 +47,15 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
     assert "Fastest within the bound" in md or "No fast variant within the bound" in md
 
 
-PAPER_PRESET = ROOT / "bench" / "paper_preset.py"
-
-
 def start_paper_preset(enamel, tmp_path):
     """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
     terminal's process group); returns once the solver has written its first partial result."""
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
-    cmd = [sys.executable, str(PAPER_PRESET), "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
+    cmd = [sys.executable, "-m", "bench.paper_preset", "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
            "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
     run = tmp_path / "runs" / "theta30_s21.4_e10_cv0"
     p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True)
+                         start_new_session=True, cwd=ROOT)
     deadline = time.time() + 120
     while time.time() < deadline and not (run / "result.partial.h5").exists():   # first progress write
         time.sleep(0.2)
@@ -81,7 +77,7 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     steps_before = int(h5py.File(run / "result.partial.h5")["meta"].attrs["steps"])
     assert 0 < steps_before < 120000
 
-    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert "continuing from the checkpoint" in r.stdout
     md = (tmp_path / "paper_preset.md").read_text()
@@ -92,7 +88,7 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     for name in ("paper_preset.png", "paper_preset.pdf"):
         assert (tmp_path / "out" / name).stat().st_size > 1000
 
-    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert r.returncode == 0 and "is complete; reporting it" in r.stdout
 
 

@@ -92,12 +92,37 @@ def test_existing_output_needs_force(run, tmp_path):
     assert (out / "result.h5").read_bytes() == b"precious"
 
 
+def info_line(stdout, label):
+    """The rest of the one `enamel-dem info` line that starts with `label` (after leading spaces)."""
+    found = [m[1] for m in re.finditer(rf"^ *{re.escape(label)} +(\S.*)$", stdout, re.M)]
+    assert len(found) == 1, (label, stdout)
+    return found[0]
+
+
+def info_count(stdout, label):
+    """The number that follows `label` on its line."""
+    m = re.match(r"(\d+)\b", info_line(stdout, label))
+    assert m, (label, stdout)
+    return int(m[1])
+
+
 def test_info_prints_counts(run):
     r = run("info", CASES / "small_theta0.toml")
     assert r.returncode == 0, r.stderr
-    # hand count of the 6 d x 4 d specimen at h_e = 0.3 d (tests/cpp/test_geometry.cpp)
-    assert "168" in r.stdout and "160" in r.stdout
-    assert "bending governs" in r.stdout
+    out = r.stdout
+    # hand count of the 6 d x 4 d specimen at h_e = 0.3 d (tests/cpp/test_geometry.cpp): 21 slices, 8 rods each
+    # in every slice, 20 interfaces per slice of which the pre-crack cuts 4 in each of slices 0..9
+    assert info_count(out, "slices") == 21
+    assert info_count(out, "rods") == 8
+    assert info_count(out, "nodes") == 8 * 21
+    assert info_count(out, "DOF") == 6 * 8 * 21
+    assert info_count(out, "beam elements") == 8 * 20
+    assert "(+0 cut by the pre-crack)" in info_line(out, "beam elements")
+    assert info_count(out, "interfaces") == 20 * 21 - 40
+    assert "(+40 cut by the pre-crack)" in info_line(out, "interfaces")
+    assert info_count(out, "ply 1") + info_count(out, "ply 2") == 6 * 21 - 2 * 10
+    assert info_count(out, "interlayer 1-2") == info_count(out, "interlayer 2-1 (periodic wrap)") == 7 * 21 - 10
+    assert "bending governs" in info_line(out, "element frequency")
 
 
 def test_time_step_above_stable_limit_is_refused(run, tmp_path):

@@ -1,13 +1,15 @@
 """Figure scripts and summary table (issue "Pipeline and figures"): each script runs on result files and writes
 a non-empty PDF and PNG, a missing result file is one clear line and a non-zero exit, the summary table has one
-row per case with our HDF5 attributes copied exactly, and paper_values.toml quotes the paper verbatim.
+row per case with our HDF5 attributes copied exactly, and each number of paper_values.toml is what its quote says.
 
 The result files come from tiny runs (8 d x 4 d specimen, stopped at Delta_a/d = 1.5, ~2 s each) made once per
-module in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/. Scripts run in this process
-(runpy) to keep the tests fast; one missing-file test runs a script as a subprocess for the real exit status.
+session (conftest.tiny_run) in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/.
+Scripts run in this process (runpy, as `python3 -m figures.<script>` runs them) to keep the tests fast; one
+missing-file test runs a script as a subprocess for the real exit status.
 """
 import contextlib
 import csv
+import fractions
 import io
 import math
 import pathlib
@@ -17,54 +19,51 @@ import shutil
 import subprocess
 import sys
 import tomllib
+import warnings
 
 import h5py
 import numpy as np
 import pytest
 
+from enamel_results.cases import params_from_name
+from enamel_results.metrics import pooled_rm
+from enamel_results.results import EXIT_MISSING, load_result
+from figures import plotting, summary_table
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIGURES = ROOT / "figures"
-sys.path.insert(0, str(FIGURES))
-import common  # noqa: E402
-import summary_table  # noqa: E402
-
 PYTHON = sys.executable
-PAPER_TEXT = pathlib.Path("/work/shared/paper/pro_barthelat_2020_enamel_dem.txt")
-MAP_SCRIPTS = ["fig4_decussation.py", "fig5_rod_strength.py", "fig6_stiffness_contrast.py",
-               "fig8_statistics_rcurves.py"]
-SCRIPTS = MAP_SCRIPTS + ["fig7_summary.py", "fig9_statistics_mean.py", "summary_table.py"]
+MAP_SCRIPTS = ["fig4_decussation", "fig5_rod_strength", "fig6_stiffness_contrast", "fig8_statistics_rcurves"]
+SCRIPTS = MAP_SCRIPTS + ["fig7_summary", "fig9_statistics_mean", "summary_table"]
 # Tiny runs: one case of Figs. 4/5/6/7 and one of Figs. 8/9 (it breaks rods).
 TINY_CASES = ["theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1"]
-TINY = ["--preset", "ci", "--set", "w_s_over_d=8", "--set", "h_s_over_d=4", "--set", "stop_da_over_d=1.5",
-        "--set", "frames_da_over_d=[0.5, 1.5]", "-q"]
 ATTR_RTOL = 1e-9  # CSV values are written with 10 significant digits
 
 
 @pytest.fixture(scope="module")
-def tiny_runs(tmp_path_factory, enamel):
-    """runs/ci/<case>/result.h5 for TINY_CASES, plus a copy of the theta_D = 30 run as its half-rate twin
-    (the figure only needs the file: this checks the overlay path without a second run)."""
-    runs = tmp_path_factory.mktemp("runs")
+def tiny_runs(tiny_run):
+    """The runs/ root holding runs/ci/<case>/result.h5 for TINY_CASES, plus a copy of the theta_D = 30 run as its
+    half-rate twin (the figure only needs the file: this checks the overlay path without a second run)."""
     for case in TINY_CASES:
-        out = runs / "ci" / case
-        r = subprocess.run([str(enamel), "run", str(ROOT / "paper_cases" / f"{case}.toml"), "--out", str(out),
-                            *TINY], capture_output=True, text=True, timeout=120)
-        assert r.returncode == 0, r.stderr
-    slow = runs / "ci" / "theta30_s21.4_e10_cv0_slow"
-    slow.mkdir()
-    shutil.copy(runs / "ci" / "theta30_s21.4_e10_cv0" / "result.h5", slow / "result.h5")
-    return runs
+        tiny_run(case)
+    slow = tiny_run.root / "ci" / "theta30_s21.4_e10_cv0_slow"
+    slow.mkdir(exist_ok=True)
+    shutil.copy(tiny_run(TINY_CASES[0]), slow / "result.h5")
+    return tiny_run.root
 
 
 def run_script(name, *args):
-    """Run a script as __main__ in this process: (exit status, stdout, stderr)."""
+    """Run figures.<name> as __main__ in this process: (exit status, stdout, stderr)."""
+    module = f"figures.{name}"
     out, err = io.StringIO(), io.StringIO()
     argv = sys.argv
-    sys.argv = [str(FIGURES / name), *map(str, args)]
+    sys.argv = [module, *map(str, args)]
     code = 0
     try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            runpy.run_path(str(FIGURES / name), run_name="__main__")
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), warnings.catch_warnings():
+            # a module the tests imported too (summary_table) runs as a fresh copy, as `python3 -m` runs it
+            warnings.filterwarnings("ignore", r".* found in sys\.modules", RuntimeWarning)
+            runpy.run_module(module, run_name="__main__", alter_sys=True)
     except SystemExit as e:
         code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
     finally:
@@ -109,32 +108,52 @@ def test_paper_values_entries_are_well_formed():
     assert by_id["fig9_R_m_low_cv"]["value"] == 11.9
 
 
-@pytest.mark.skipif(not PAPER_TEXT.exists(), reason="paper text not on this machine")
-def test_paper_values_quote_the_paper_verbatim():
-    norm = lambda s: re.sub(r"\s+", " ", s).strip()  # noqa: E731 - line breaks of the text do not matter
-    text = norm(PAPER_TEXT.read_text())
+def quoted_number(relation, number):
+    """The pattern of a number as the paper's text writes it after its relation: '\approx 7', '= 4/3'."""
+    sign = {"~": r"\\approx\s*", "=": r"=\s*"}[relation]
+    return sign + re.escape(number) + r"(?![\d./])"
+
+
+def test_paper_values_state_what_their_quotes_say():
+    """Each number in paper_values.toml is the number its quoted sentence states, with the sentence's relation:
+    value == value_text == the text after '\approx' or '=' in the quote; a derived value is its derivation from
+    the quote. (Whether each quote is verbatim in the paper was checked against the paper's text when the
+    entries were written; the repository does not ship that text, so the tests cannot re-read it.)"""
     pv = tomllib.loads((FIGURES / "paper_values.toml").read_text())
     for v in pv["value"] + pv["trend"] + pv["snapshot"]:
-        assert norm(v["quote"]) in text, v.get("id", v.get("figure"))
-        if "value_text" in v and not v.get("derived"):
-            number = v["value_text"].replace("approx ", "")
-            assert number in v["quote"], (v["id"], number)
+        assert len(v["quote"].split()) >= 5, v
+    for v in pv["value"]:
+        quote, text, value = v["quote"], v["value_text"], float(v["value"])
+        if not v.get("derived"):
+            number = text.replace("approx ", "")
+            assert value == pytest.approx(float(fractions.Fraction(number)), rel=1e-15), v["id"]
+            assert re.search(quoted_number(v["relation"], number), quote), (v["id"], number)
+        elif text == "d/sin(theta_D)":  # the crisscross spacing along x, for the case's theta_D
+            theta = params_from_name(v["case"])["theta_D"]
+            assert value == pytest.approx(1 / math.sin(math.radians(theta)), rel=1e-12), v["id"]
+            assert r"\frac{d}{\sin(\theta_D)}" in quote, v["id"]
+        else:  # '... on the order of 50% below X': half of X, both numbers in the quote
+            m = re.fullmatch(r"on the order of (\d+)% below ([\d.]+)", text)
+            assert m, (v["id"], text)
+            assert value == pytest.approx(float(m[2]) * (1 - float(m[1]) / 100), rel=1e-12), v["id"]
+            assert f"{m[1]}%" in quote and re.search(quoted_number("~", m[2]), quote), v["id"]
+    for snap in pv["snapshot"]:
+        assert re.search(quoted_number("=", f"{float(snap['da_over_d']):g}"), snap["quote"]), snap
 
 
 # ------------------------------------------------------------------------------------------ scripts
-@pytest.mark.parametrize("script", SCRIPTS + ["../pipeline/export_vtk.py"])
+@pytest.mark.parametrize("script", SCRIPTS)  # pipeline.export_vtk's: test_vtk.py
 def test_help(script):
     code, out, err = run_script(script, "--help")
     assert code == 0, err
     assert "usage:" in out
-    if script != "../pipeline/export_vtk.py":
-        assert "--preset" in out and "reduced" in out
+    assert "--preset" in out and "reduced" in out
 
 
 @pytest.mark.parametrize("script", SCRIPTS)
 def test_missing_result_is_one_clear_line(script, tmp_path):
     code, _, err = run_script(script, "--preset", "ci", "--runs", tmp_path / "runs", "--out", tmp_path / "out")
-    assert code == common.EXIT_MISSING, (code, err)
+    assert code == EXIT_MISSING, (code, err)
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
     assert str(tmp_path / "runs" / "ci") in lines[0] and "result.h5" in lines[0]
@@ -143,20 +162,20 @@ def test_missing_result_is_one_clear_line(script, tmp_path):
 
 
 def test_missing_result_exit_status_in_a_subprocess(tmp_path):
-    r = subprocess.run([PYTHON, str(FIGURES / "fig4_decussation.py"), "--preset", "ci", "--runs",
-                        str(tmp_path)], capture_output=True, text=True, timeout=60)
-    assert r.returncode == common.EXIT_MISSING
+    r = subprocess.run([PYTHON, "-m", "figures.fig4_decussation", "--preset", "ci", "--runs", str(tmp_path)],
+                       capture_output=True, text=True, timeout=60, cwd=ROOT)
+    assert r.returncode == EXIT_MISSING
     assert len(r.stderr.strip().splitlines()) == 1 and "make runs PRESET=ci" in r.stderr
 
 
-# fig5 and fig6 are fig4's code (common.map_figure) with other cases: --help and the missing-file test cover them.
-@pytest.mark.parametrize("script", ["fig4_decussation.py", "fig8_statistics_rcurves.py", "fig7_summary.py",
-                                    "fig9_statistics_mean.py"])
+# fig5 and fig6 are fig4's code (plotting.map_figure) with other cases: --help and the missing-file test cover them.
+@pytest.mark.parametrize("script", ["fig4_decussation", "fig8_statistics_rcurves", "fig7_summary",
+                                    "fig9_statistics_mean"])
 def test_figure_scripts_draw_available_results(script, tiny_runs, tmp_path):
     code, out, err = run_script(script, "--preset", "ci", "--runs", tiny_runs, "--out", tmp_path,
                                 "--allow-missing")
     assert code == 0, err
-    stem = pathlib.Path(script).stem
+    stem = script
     assert_image_files(tmp_path, stem)
     assert str(tmp_path / "ci" / f"{stem}.png") in out
     assert "warning: skipping missing" in err  # the tiny tree lacks most cases, and says so
@@ -164,7 +183,7 @@ def test_figure_scripts_draw_available_results(script, tiny_runs, tmp_path):
 
 # ------------------------------------------------------------------------------------------ summary table
 def test_summary_table_rows_columns_and_values(tiny_runs, tmp_path):
-    code, _, err = run_script("summary_table.py", "--preset", "ci", "--runs", tiny_runs, "--out", tmp_path,
+    code, _, err = run_script("summary_table", "--preset", "ci", "--runs", tiny_runs, "--out", tmp_path,
                               "--allow-missing")
     assert code == 0, err
     with open(tmp_path / "ci" / "summary.csv") as f:
@@ -186,7 +205,7 @@ def test_summary_table_rows_columns_and_values(tiny_runs, tmp_path):
                         "da_max_over_d"):
                 assert float(row[col]) == pytest.approx(float(rc[col]), rel=ATTR_RTOL), (case, col)
             assert int(row["broken_rod_elements"]) == int(h["history/broken_rod_elements"][-1])
-        assert float(row["theta_D"]) == common.params_from_name(case)["theta_D"]
+        assert float(row["theta_D"]) == params_from_name(case)["theta_D"]
     assert by_case["theta0_s14.3_e5_cv0"]["status"] == "missing"
     assert float(by_case["theta0_s21.4_e10_cv0"]["paper_R_init_over_Gamma"]) == pytest.approx(4 / 3, rel=1e-5)
     assert by_case["theta0_s21.4_e10_cv0"]["paper_R_m_pooled_over_Gamma"] == "", "pooled values: Figs. 8/9 only"
@@ -197,26 +216,26 @@ def test_summary_table_rows_columns_and_values(tiny_runs, tmp_path):
 
 
 def test_summary_table_without_allow_missing_fails(tiny_runs, tmp_path):
-    code, _, err = run_script("summary_table.py", "--preset", "ci", "--runs", tiny_runs, "--out", tmp_path)
-    assert code == common.EXIT_MISSING
+    code, _, err = run_script("summary_table", "--preset", "ci", "--runs", tiny_runs, "--out", tmp_path)
+    assert code == EXIT_MISSING
     assert "make runs PRESET=ci" in err
 
 
-# ------------------------------------------------------------------------------------------ common.py
+# ------------------------------------------------------------------------------------------ enamel_results
 def test_loaded_result_matches_file_and_pooled_rm_matches_solver(tiny_runs):
     path = tiny_runs / "ci" / "theta30_s28.5_e10_cv0.3_seed1" / "result.h5"
-    r = common.load_result(path, full=True)
+    r = load_result(path, full=True)
     assert r.case == "theta30_s28.5_e10_cv0.3_seed1"
     assert (r.param("theta_D"), r.param("sigma_ru_over_sigma0"), r.param("cv"), r.param("seed")) == (30, 28.5, 0.3, 1)
     assert len(r.da) == len(r.R) > 0
     assert r.geometry.iface_midpoint.shape == (len(r.geometry.iface_tag), 3)
     assert all(f.iface_state.shape == r.geometry.iface_tag.shape for f in r.frames)
     # Python's pooled mean/std over one realisation = the solver's R_m, dR_m (same definition, output.cpp)
-    m, s, n = common.pooled_rm([r])
+    m, s, n = pooled_rm([r])
     assert n == np.count_nonzero((r.da > 0) & (r.da < 30))
     assert m == pytest.approx(r.R_m, rel=1e-12) and s == pytest.approx(r.dR_m, rel=1e-9, abs=1e-12)
     # pooling two copies: same mean and std, twice the points
-    assert common.pooled_rm([r, r])[:2] == pytest.approx((m, s), rel=1e-12)
+    assert pooled_rm([r, r])[:2] == pytest.approx((m, s), rel=1e-12)
     # the first broken rod: where the history's count first becomes positive
     with h5py.File(path, "r") as h:
         broken, da = h["history/broken_rod_elements"][:], h["history/da_over_d"][:]
@@ -243,9 +262,9 @@ def test_unfinished_run_is_drawn_and_flagged(tiny_runs, tmp_path):
     shutil.copy(tiny_runs / "ci" / case / "result.h5", runs / "ci" / case / "result.h5")
     with h5py.File(runs / "ci" / case / "result.h5", "r+") as h:
         h["meta"].attrs["status"] = "interrupted"
-    r = common.load_result(runs / "ci" / case / "result.h5")
-    assert not r.completed and "NOT COMPLETED: interrupted" in common.status_flag(r)
-    code, _, err = run_script("summary_table.py", "--preset", "ci", "--runs", runs, "--out", tmp_path / "out",
+    r = load_result(runs / "ci" / case / "result.h5")
+    assert not r.completed and "NOT COMPLETED: interrupted" in plotting.status_flag(r)
+    code, _, err = run_script("summary_table", "--preset", "ci", "--runs", runs, "--out", tmp_path / "out",
                               "--allow-missing")
     assert code == 0, err
     with open(tmp_path / "out" / "ci" / "summary.csv") as f:

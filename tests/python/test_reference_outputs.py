@@ -1,21 +1,18 @@
 """Reference outputs (issue "Pipeline and figures"): re-run the reference cases at the ci preset and compare
 R-curves and failure counts with tests/reference/<case>.json within the tolerances stored there
-(tests/reference/make_reference.py states why each is what it is; `make reference` regenerates them)."""
+(tests/reference/make_reference.py states why each is what it is; `make reference` regenerates them).
+The runs are the session's shared ci runs (conftest.ci_run), made as make_reference.run_case makes them."""
 import json
-import pathlib
-import sys
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "reference"))
-import make_reference  # noqa: E402  (puts figures/ on the path)
-import common  # noqa: E402
+from enamel_results.metrics import rcurve_rel_l2
+from tests.reference import make_reference
 
 
 def rcurve_difference(ref, new):
     """Relative L2 difference of two R-curves over their common Delta_a range (50 points)."""
-    return common.rcurve_rel_l2(ref["da_over_d"], ref["R_over_Gamma"], new["da_over_d"], new["R_over_Gamma"])
+    return rcurve_rel_l2(ref["da_over_d"], ref["R_over_Gamma"], new["da_over_d"], new["R_over_Gamma"])
 
 
 def compare(ref, new):
@@ -38,10 +35,9 @@ def compare(ref, new):
 
 
 @pytest.mark.parametrize("case", make_reference.CASES)
-def test_reference_rcurve_within_tolerance(case, enamel, tmp_path, monkeypatch):
-    monkeypatch.setenv("ENAMEL_BINARY", str(enamel))
+def test_reference_rcurve_within_tolerance(case, ci_run):
     ref = json.loads((make_reference.HERE / f"{case}.json").read_text())
-    new = make_reference.run_case(case, tmp_path / case)
+    new = make_reference.summarise(ci_run(case))
     print(f"{case}: R_init {new['R_init_over_Gamma']:.4f} (ref {ref['R_init_over_Gamma']:.4f}), "
           f"R_ss {new['R_ss_over_Gamma']:.4f} (ref {ref['R_ss_over_Gamma']:.4f}), "
           f"broken {new['broken_rod_elements']} (ref {ref['broken_rod_elements']}), "

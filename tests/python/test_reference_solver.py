@@ -1,19 +1,21 @@
 """Reference-solver checks that run the binary at the `ci` preset (issue "Reference solver"):
 theta_D = 0 gives R = 4/3 Gamma_i, half the loading rate gives the same R-curve, theta_D = 30 runs to its
-stop criterion with broken rods and a rising R-curve, and result.h5 has the documented layout."""
+stop criterion with broken rods and a rising R-curve, and result.h5 has the documented layout.
+The theta_D = 0 and 30 runs are the session's shared ci runs (conftest.ci_run)."""
 import h5py
 import numpy as np
 import pytest
 
-from conftest import CASES
+from conftest import PAPER_CASES
 
 R_THEORY = 4.0 / 3.0   # paper: corrugated crack faces, 4/3 of a flat crack's area per unit advance
 TOL_THEORY = 0.03      # issue: R_init and R_ss within 3% of 4/3
 TOL_RATE = 0.02        # issue: half the loading rate gives an R-curve within 2%
+THETA0, THETA30 = "theta0_s21.4_e10_cv0", "theta30_s21.4_e10_cv0"
 
 
 def run_case(run, out, case, *sets):
-    args = ["run", CASES / case, "--preset", "ci", "--out", out, "--quiet"]
+    args = ["run", PAPER_CASES / f"{case}.toml", "--preset", "ci", "--out", out, "--quiet"]
     for s in sets:
         args += ["--set", s]
     r = run(*args, timeout=900)
@@ -22,20 +24,19 @@ def run_case(run, out, case, *sets):
 
 
 @pytest.fixture(scope="module")
-def theta0(run, tmp_path_factory):
-    return run_case(run, tmp_path_factory.mktemp("theta0"), "theta0_s21.4_e10.toml")
+def theta0(ci_run):
+    return h5py.File(ci_run(THETA0), "r")
 
 
 @pytest.fixture(scope="module")
 def theta0_half_rate(run, tmp_path_factory, theta0):
     rate = float(theta0["meta"].attrs["v_app"]) / float(theta0["meta"].attrs["c_d_over_cr"])
-    return run_case(run, tmp_path_factory.mktemp("theta0_half"), "theta0_s21.4_e10.toml",
-                    f"v_app_over_cd={rate / 2}")
+    return run_case(run, tmp_path_factory.mktemp("theta0_half"), THETA0, f"v_app_over_cd={rate / 2}")
 
 
 @pytest.fixture(scope="module")
-def theta30(run, tmp_path_factory):
-    return run_case(run, tmp_path_factory.mktemp("theta30"), "theta30_s21.4_e10.toml")
+def theta30(ci_run):
+    return h5py.File(ci_run(THETA30), "r")
 
 
 def test_theta0_gives_four_thirds(theta0):

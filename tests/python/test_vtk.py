@@ -2,7 +2,6 @@
 cell per rod element and one vertex per interface, the named data arrays, and the frame's flags unchanged; the
 recomputed rod stress follows the beam formulas and never exceeds the strength of an intact element.
 """
-import pathlib
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -12,14 +11,11 @@ import meshio
 import numpy as np
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "pipeline"))
-sys.path.insert(0, str(ROOT / "figures"))
-import export_vtk  # noqa: E402
+from conftest import ROOT
+from enamel_results.results import load_result
+from pipeline import export_vtk
 
 CASE = "theta30_s28.5_e10_cv0.3_seed1"  # breaks rod elements within Delta_a/d = 1.5 on the tiny specimen
-TINY = ["--preset", "ci", "--set", "w_s_over_d=8", "--set", "h_s_over_d=4", "--set", "stop_da_over_d=1.5",
-        "--set", "frames_da_over_d=[0.5, 1.5]", "-q"]
 ROD_CELL_DATA = {"broken", "strength_over_sigma0", "stress_over_sigma0", "stress_ratio"}
 IFACE_CELL_DATA = {"damage", "state", "tag"}
 # The frames store displacements as float32 (relative precision 6e-8), so the recomputed stress carries ~1e-6
@@ -30,12 +26,8 @@ RATIO_TOL = 0.02
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory, enamel):
-    out = tmp_path_factory.mktemp("run") / CASE
-    r = subprocess.run([str(enamel), "run", str(ROOT / "paper_cases" / f"{CASE}.toml"), "--out", str(out), *TINY],
-                       capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    return out / "result.h5"
+def result(tiny_run):
+    return tiny_run(CASE)
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +46,7 @@ def distinct_frame_count(steps):
 
 
 def test_vtu_series_read_back(result, h5, tmp_path):
-    r = subprocess.run([sys.executable, str(ROOT / "pipeline" / "export_vtk.py"), str(result), str(tmp_path)],
+    r = subprocess.run([sys.executable, "-m", "pipeline.export_vtk", str(result), str(tmp_path)], cwd=ROOT,
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     n = distinct_frame_count(h5["steps"])
@@ -99,7 +91,7 @@ def test_xdmf_series_read_back(result, h5, tmp_path):
 
 
 def test_intact_rods_stay_below_their_strength(result):
-    r = export_vtk.common.load_result(result, full=True)
+    r = load_result(result, full=True)
     g = r.geometry
     sec = export_vtk.section_properties(r.params.get("section", "hexagon"))
     assert r.broken_rods > 0

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Regenerate the reference outputs in tests/reference/ (`make reference`).
+"""Regenerate the reference outputs in tests/reference/ (`make reference`, or from the repository root
+`python3 -m tests.reference.make_reference`).
 
 Runs each reference case of paper_cases/ at the `ci` preset with the current solver and writes
 tests/reference/<case>.json: the R-curve (Delta_a/d, R/Gamma_i), R_init, R_ss, and the final failure counts.
@@ -12,15 +13,14 @@ import json
 import os
 import pathlib
 import subprocess
-import sys
 import tempfile
 
 import h5py
 
+from enamel_results import paths
+
 HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
-sys.path.insert(0, str(ROOT / "figures"))
-import paths  # noqa: E402
+ROOT = paths.ROOT
 
 PRESET = "ci"
 CASES = ["theta0_s21.4_e10_cv0", "theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.2_seed1"]

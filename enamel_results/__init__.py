@@ -1,0 +1,13 @@
+"""enamel_results: the Python side's library for enamel-dem's HDF5 results (no plotting).
+
+    paths          the one place that defines the pipeline's paths (paper_cases/, runs/, figures/out/, bench/)
+    cases          paper_cases/figures.toml (which figure uses which case) and parameters from case names
+    paper_values   figures/paper_values.toml: the numbers the paper states, with their sentences
+    results        load one result.h5 (Result, Geometry, Frame), interface tags, EXIT_MISSING
+    metrics        R-curve comparison and the pooled R_m of Fig. 9
+    cli            the figure scripts' shared command line and loading of a figure's runs
+
+figures/, bench/, pipeline/ and tests/ import it as `from enamel_results import results`; they find it because
+they run with the repository root on sys.path: `python3 -m figures.fig4_decussation` from the root (what the
+Makefile does), and pytest through the root's pytest.ini (`pythonpath = .`). Nothing here imports matplotlib.
+"""
