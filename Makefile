@@ -29,7 +29,7 @@ RUN_SET ?=
 # Debian packages: the complete set needed to build, test and draw figures.
 DEB_PACKAGES := g++ make cmake pkg-config git \
   libeigen3-dev libsuitesparse-dev libhdf5-dev libtomlplusplus-dev libcli11-dev libgtest-dev \
-  python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest
+  python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest python3-vtk9
 
 # An interpreter that can import the pipeline's modules. The `python3` first on PATH may be a
 # pyenv one without them, so probe the Debian interpreter first; fall back to it (after
