@@ -175,7 +175,7 @@ SLURM_DIR = $(RUNS)/$(PRESET)/slurm
 SLURM_CPUS ?= 1
 SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY PYTHON   # passed on to the jobs' make when given on the command line
 slurm_opt = $(if $(2),'--$(1)=$(subst ','\'',$(2))')
-slurm: check-preset $(ENAMEL)
+slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 	$(PYTHON) pipeline/slurm_jobs.py --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \
 	  --cpus $(SLURM_CPUS) $(call slurm_opt,partition,$(SLURM_PARTITION)) $(call slurm_opt,account,$(SLURM_ACCOUNT)) \
 	  $(call slurm_opt,time,$(SLURM_TIME)) $(call slurm_opt,mem,$(SLURM_MEM)) $(call slurm_opt,then,$(SLURM_THEN)) \

@@ -243,7 +243,7 @@ def main(argv=None) -> int:
     logs.mkdir(exist_ok=True)
     (out / "runs.sbatch").write_text(header + sbatch_lines(array) + extra + body)
 
-    then = a.then if a.then is not None else ("none" if a.cases is not None else f"{make} figures")
+    then = a.then if a.then is not None else ("none" if a.cases is not None else f"{make} figures-all")
     figures_part = ""
     if then != "none":
         fig = {"job-name": f"enamel-{a.preset}-figures", "chdir": str(paths.ROOT),
