@@ -21,13 +21,15 @@ Resources (every task of an array gets the same): memory is the largest of the s
 (`enamel-dem info --estimate`) over the runs, x1.25 + 256 MB; time is the bench's cost model for one core:
 steps x DOF / (DOF-updates per second), with the steps of a whole run and the DOF-updates/s of the `lumped`
 scheme at the nearest measured size in bench/cost_growth.csv (its estimate at loading rate 1e-3 c_d, the
-slowest preset rate; x2 for half-rate twins), x2, at least 10 min. A task that reaches its time limit is
+slowest preset rate; x2 for half-rate twins), x2, between 10 min and 24 h (a common partition limit). A task that reaches its time limit is
 requeued and continues, so an estimate that is too short costs a wait in the queue, not work. --mem and
 --time replace the estimates.
 """
 import argparse
+import concurrent.futures
 import csv
 import math
+import os
 import pathlib
 import shlex
 import subprocess
@@ -41,7 +43,7 @@ from make_rules import figure_set  # noqa: E402  (the one place that lists the r
 
 PROG = "slurm_jobs.py"
 MEM_FACTOR, MEM_EXTRA_MB = 1.25, 256     # memory request: solver estimate x1.25 + 256 MB (make, shell, HDF5)
-TIME_FACTOR, TIME_MIN_S = 2.0, 600       # time request: cost-model estimate x2, at least 10 min
+TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: cost-model estimate x2, 10 min to 24 h
 COST_CSV = paths.BENCH / "cost_growth.csv"
 
 
@@ -135,6 +137,7 @@ targets=(
 {targets})
 target=${{targets[$SLURM_ARRAY_TASK_ID]}}
 export OMP_THREAD_LIMIT=${{SLURM_CPUS_PER_TASK:-1}}   # the solver's automatic thread count stays in the allocation
+unset MAKEFLAGS MFLAGS MAKELEVEL   # a make of its own, whatever the submitting shell was
 say() {{ echo "$(date '+%F %T') task $SLURM_ARRAY_TASK_ID (job $SLURM_JOB_ID): $*"; }}
 say "start $((${{SLURM_RESTART_COUNT:-0}} + 1)) on $(hostname): make $target"
 
@@ -171,7 +174,7 @@ echo "array $array: {n} runs of preset {preset}; logs $here/logs/run-${{array}}_
 {figures}"""
 
 SUBMIT_FIGURES = r"""figures=$(sbatch --parsable --dependency=afterok:$array "$here/figures.sbatch"); figures=${{figures%%;*}}
-echo "figures $figures: {then} once every task of $array has succeeded; log $here/logs/figures-$figures.out"
+echo "figures $figures:" {then} "once every task of $array has succeeded; log $here/logs/figures-$figures.out"
 """
 
 
@@ -214,7 +217,8 @@ def main(argv=None) -> int:
 
     note = []
     if a.mem is None or a.time is None:
-        est = {r: estimate(a.solver, a.preset, r, run_set) for r in runs}
+        with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 2) as pool:
+            est = dict(zip(runs, pool.map(lambda r: estimate(a.solver, a.preset, r, run_set), runs)))
     if a.mem is None:
         mb = max(e["memory_mb"] for e in est.values())
         a.mem = f"{math.ceil((mb * MEM_FACTOR + MEM_EXTRA_MB) / 100) * 100}M"
@@ -222,7 +226,7 @@ def main(argv=None) -> int:
     if a.time is None:
         rows = cost_rows()
         s = max(estimate_seconds(e["dof"], r.endswith("_slow"), rows) for r, e in est.items())
-        a.time = slurm_time(max(TIME_MIN_S, TIME_FACTOR * s))
+        a.time = slurm_time(min(TIME_MAX_S, max(TIME_MIN_S, TIME_FACTOR * s)))
         note.append(f"--time {a.time} (cost model {s / 3600:.2g} h on one core, longest run)")
 
     common = {"partition": a.partition, "account": a.account}
@@ -251,9 +255,9 @@ def main(argv=None) -> int:
                "mem": a.figures_mem, "time": a.figures_time, **common}
         (out / "figures.sbatch").write_text(
             header + sbatch_lines(fig) + extra +
-            f'\necho "$(date \'+%F %T\') figures (job $SLURM_JOB_ID) on $(hostname): {then}"\n{then}\n'
+            f'\necho "$(date \'+%F %T\') figures (job $SLURM_JOB_ID) on $(hostname):" {shlex.quote(then)}\n{then}\n'
             'rc=$?\necho "$(date \'+%F %T\') figures: exit status $rc"\nexit $rc\n')
-        figures_part = SUBMIT_FIGURES.format(then=then.replace('"', '\\"'))
+        figures_part = SUBMIT_FIGURES.format(then=shlex.quote(then))
     else:
         (out / "figures.sbatch").unlink(missing_ok=True)
     submit = out / "submit.sh"

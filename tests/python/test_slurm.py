@@ -38,6 +38,7 @@ RUN_SET = "threads=1 w_s_over_d=8 h_s_over_d=4 stop_da_over_d=1.5 frames_da_over
 CHECKPOINT_EVERY = "0.2"                                       # s: a checkpoint soon after each run starts
 RUN_ENV_ATTRS = {"wall_time_s", "peak_memory_mb", "written_utc"}   # attributes of the process, not the result
 DAEMONS = ("munged", "mungekey", "slurmctld", "slurmd", "sbatch", "scontrol", "scancel", "sinfo")
+OUTER = ("SLURM_", "SBATCH_", "SALLOC_", "SRUN_", "SQUEUE_", "MAKEFLAGS", "MFLAGS", "MAKELEVEL")
 TIMEOUT = 240                                                  # s: the whole array and figures job
 FINAL = {"COMPLETED", "FAILED", "CANCELLED", "TIMEOUT", "NODE_FAIL", "OUT_OF_MEMORY", "PREEMPTED", "BOOT_FAIL",
          "DEADLINE"}
@@ -79,7 +80,8 @@ class Cluster:
     def __init__(self, root: pathlib.Path):
         self.root, self.procs = root, {}
         self.conf = root / "slurm.conf"
-        self.env = dict(os.environ, SLURM_CONF=str(self.conf))
+        # nothing of an outer SLURM job or an outer make (`make test`) reaches this cluster or the jobs' make
+        self.env = {k: v for k, v in os.environ.items() if not k.startswith(OUTER)} | {"SLURM_CONF": str(self.conf)}
         self.marker = f"SLURM_CONF={self.conf}".encode()
 
     def cmd(self, *args, check=True, timeout=30):
@@ -189,6 +191,8 @@ AccountingStorageType=accounting_storage/none
 MpiDefault=none
 ReturnToService=2
 MailProg=/bin/true
+# the main scheduling loop every 2 s (default 60 s): it is what starts a requeued job once its wait is over
+SchedulerParameters=sched_interval=2
 MinJobAge=3600
 KillWait=30
 NodeName={host} NodeAddr=127.0.0.1 CPUs={cpus} RealMemory={mem_mb} State=UNKNOWN
@@ -300,7 +304,8 @@ def test_array_requeued_mid_run_resumes_bit_for_bit_then_figures(slurm, enamel, 
 
     # the uninterrupted runs, through the same Make rule, while SLURM works
     refs = [subprocess.Popen(make + [f"RUNS={ref}", str(ref / "ci" / c / "result.h5")], stdout=subprocess.PIPE,
-                             stderr=subprocess.STDOUT, text=True, start_new_session=True) for c in CASES]
+                             stderr=subprocess.STDOUT, text=True, env=slurm.env, start_new_session=True)
+            for c in CASES]
     request.addfinalizer(lambda: [os.killpg(p.pid, signal.SIGKILL) for p in refs if p.poll() is None])
 
     logs = [scripts / "logs" / f"run-{array}_{i}.out" for i in range(2)]
