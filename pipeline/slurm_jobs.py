@@ -21,9 +21,9 @@ Resources (every task of an array gets the same): memory is the largest of the s
 (`enamel-dem info --estimate`) over the runs, x1.25 + 256 MB; time is the bench's cost model for one core:
 steps x DOF / (DOF-updates per second), with the steps of a whole run and the DOF-updates/s of the `lumped`
 scheme at the nearest measured size in bench/cost_growth.csv (its estimate at loading rate 1e-3 c_d, the
-slowest preset rate; x2 for half-rate twins), x2, between 10 min and 24 h (a common partition limit). A task that reaches its time limit is
-requeued and continues, so an estimate that is too short costs a wait in the queue, not work. --mem and
---time replace the estimates.
+slowest preset rate; x2 for half-rate twins), x2, between 10 min and 24 h (a common partition limit). A task
+that reaches its time limit is requeued and continues, so an estimate that is too short costs a wait in the
+queue, not work. --mem and --time replace the estimates.
 """
 import argparse
 import concurrent.futures
@@ -45,6 +45,10 @@ PROG = "slurm_jobs.py"
 MEM_FACTOR, MEM_EXTRA_MB = 1.25, 256     # memory request: solver estimate x1.25 + 256 MB (make, shell, HDF5)
 TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: cost-model estimate x2, 10 min to 24 h
 COST_CSV = paths.BENCH / "cost_growth.csv"
+
+
+class EstimateError(Exception):
+    pass
 
 
 def fail(msg: str) -> None:
@@ -88,7 +92,7 @@ def estimate(solver: pathlib.Path, preset: str, run: str, run_set: list[str]) ->
     try:
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     except OSError as e:
-        fail(f"cannot run the solver {solver} ({e}): run `make build`, or give --mem and --time")
+        raise EstimateError(f"cannot run the solver {solver} ({e}): run `make build`")
     out = {}
     for line in r.stdout.splitlines():
         parts = line.split()
@@ -96,7 +100,7 @@ def estimate(solver: pathlib.Path, preset: str, run: str, run_set: list[str]) ->
             out[parts[0]] = int(float(parts[1]))
     if r.returncode != 0 or len(out) != 2:
         why = (r.stderr.strip().splitlines() or ["no 'dof' and 'memory_mb' lines"])[0]
-        fail(f"`{' '.join(cmd[1:])}`: {why} (give --mem and --time to skip the estimate)")
+        raise EstimateError(f"`{' '.join(cmd[1:])}`: {why}")
     return out
 
 
@@ -173,7 +177,8 @@ array=$(sbatch --parsable "$here/runs.sbatch"); array=${{array%%;*}}
 echo "array $array: {n} runs of preset {preset}; logs $here/logs/run-${{array}}_<task>.out"
 {figures}"""
 
-SUBMIT_FIGURES = r"""figures=$(sbatch --parsable --dependency=afterok:$array "$here/figures.sbatch"); figures=${{figures%%;*}}
+SUBMIT_FIGURES = r"""figures=$(sbatch --parsable --dependency=afterok:$array "$here/figures.sbatch")
+figures=${{figures%%;*}}
 echo "figures $figures:" {then} "once every task of $array has succeeded; log $here/logs/figures-$figures.out"
 """
 
@@ -216,9 +221,13 @@ def main(argv=None) -> int:
     make = f"make --no-print-directory -o {shlex.quote(str(a.solver))} {quote_vars(make_vars)}"
 
     note = []
-    if a.mem is None or a.time is None:
+    # the estimates (with --mem and --time given, one: it checks the solver, the preset and RUN_SET)
+    try:
         with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 2) as pool:
-            est = dict(zip(runs, pool.map(lambda r: estimate(a.solver, a.preset, r, run_set), runs)))
+            todo = runs if a.mem is None or a.time is None else runs[:1]
+            est = dict(zip(todo, pool.map(lambda r: estimate(a.solver, a.preset, r, run_set), todo)))
+    except EstimateError as e:
+        fail(str(e))    # one line, whichever run failed first
     if a.mem is None:
         mb = max(e["memory_mb"] for e in est.values())
         a.mem = f"{math.ceil((mb * MEM_FACTOR + MEM_EXTRA_MB) / 100) * 100}M"

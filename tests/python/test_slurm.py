@@ -356,3 +356,43 @@ def test_array_requeued_mid_run_resumes_bit_for_bit_then_figures(slurm, enamel, 
     png = figs / "ci" / "fig4_decussation.png"
     assert png.exists(), fig_log
     assert png.stat().st_mtime >= max((d / "result.h5").stat().st_mtime for d in dirs)
+
+
+def make_slurm(enamel, runs, *args):
+    """`make slurm` (no cluster needed) with the jobs' runs under `runs`."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(OUTER)}
+    return subprocess.run(["make", "--no-print-directory", "-C", str(ROOT), "-o", str(enamel), f"ENAMEL={enamel}",
+                           f"PYTHON={sys.executable}", f"RUNS={runs}", *args, "slurm"],
+                          capture_output=True, text=True, env=env, timeout=300)
+
+
+def test_array_has_one_task_per_run_of_the_figure_set(enamel, tmp_path):
+    r = make_slurm(enamel, tmp_path, "PRESET=reduced", "SLURM_MEM=2G", "SLURM_TIME=1:00:00",
+                   "SLURM_PARTITION=long", "SLURM_SBATCH=--qos=low --nice=5")
+    assert r.returncode == 0, r.stderr
+    script = (tmp_path / "reduced" / "slurm" / "runs.sbatch").read_text()
+    targets = re.findall(r"^  (\S+)/result\.h5   # task (\d+)$", script, re.M)
+    mk = dict(re.findall(r"^(ALL_CASES|ALL_SLOW) := (.*)$", (ROOT / "build" / "figures.mk").read_text(), re.M))
+    want = mk["ALL_CASES"].split() + [f"{c}_slow" for c in mk["ALL_SLOW"].split()]
+    assert [pathlib.Path(t).name for t, _ in targets] == want
+    assert [int(i) for _, i in targets] == list(range(len(want)))
+    assert f"#SBATCH --array=0-{len(want) - 1}\n" in script
+    for line in ("--mem=2G", "--time=1:00:00", "--partition=long", "--qos=low", "--nice=5", "--requeue",
+                 "--open-mode=append", "--signal=B:USR1@300"):
+        assert f"#SBATCH {line}\n" in script, line
+    assert "--dependency=afterok:$array" in (tmp_path / "reduced" / "slurm" / "submit.sh").read_text()
+    assert "figures-all" in (tmp_path / "reduced" / "slurm" / "figures.sbatch").read_text()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["PRESET=nope"], "PRESET=nope is not a preset"),
+    (["PRESET=ci", "CASES=theta99_nope"], "'theta99_nope' is not a run of the figure set"),
+    (["PRESET=ci", "CASES="], "--cases given without any run"),
+    (["PRESET=ci", "RUN_SET=nokey=1"], "unknown key 'nokey'"),
+])
+def test_bad_input_is_one_line(enamel, tmp_path, args, message):
+    r = make_slurm(enamel, tmp_path, *args)
+    assert r.returncode != 0
+    lines = [line for line in r.stderr.splitlines() if not line.startswith("make: ***")]
+    assert len(lines) == 1 and message in lines[0], r.stderr
+    assert not (tmp_path / "ci" / "slurm").exists()
