@@ -8,10 +8,11 @@
 #                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
 #                 number of cores). A run that was stopped continues from its checkpoint.
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
-#   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM= SLURM_CPUS=
-#                 SLURM_SBATCH="--qos=... ..." SLURM_THEN="command"]  SLURM job scripts in runs/<preset>/slurm/: a job
-#                 array of the runs (one task each, checkpointed and requeued at the time limit) and a figures job
-#                 after it; submit with runs/<preset>/slurm/submit.sh (README: Cluster runs)
+#   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
+#                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
+#                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
+#                 time limit) and a figures job after it; submit with runs/<preset>/slurm/submit.sh (README:
+#                 Cluster runs)
 #   make vtk      [PRESET=...]  ParaView files (.pvd + .vtu series) of every finished run, in runs/<preset>/<case>/vtk/
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
@@ -179,6 +180,7 @@ slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 	$(PYTHON) pipeline/slurm_jobs.py --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \
 	  --cpus $(SLURM_CPUS) $(call slurm_opt,partition,$(SLURM_PARTITION)) $(call slurm_opt,account,$(SLURM_ACCOUNT)) \
 	  $(call slurm_opt,time,$(SLURM_TIME)) $(call slurm_opt,mem,$(SLURM_MEM)) $(call slurm_opt,then,$(SLURM_THEN)) \
+	  $(call slurm_opt,signal-seconds,$(SLURM_SIGNAL)) \
 	  $(call slurm_opt,run-set,$(RUN_SET)) $(foreach o,$(SLURM_SBATCH),$(call slurm_opt,sbatch,$(o))) \
 	  $(foreach v,$(SLURM_PASS),$(if $(filter command line,$(origin $(v))),$(call slurm_opt,make-var,$(v)=$($(v))))) \
 	  $(if $(CASES),--cases $(CASES)) $(if $(filter command line,$(origin CASES)),$(if $(CASES),,--cases))

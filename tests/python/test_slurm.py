@@ -162,7 +162,6 @@ def slurm(tmp_path_factory, request):
         pytest.fail("SLURM cannot start: munged made no socket in 10 s:\n" + tail(root / "log" / "munged.out"))
 
     host = socket.gethostname().split(".")[0]
-    cpus = min(2, os.cpu_count() or 1)
     mem_mb = int(int(re.search(r"MemTotal:\s+(\d+)", pathlib.Path("/proc/meminfo").read_text()).group(1)) / 1024 * 0.8)
     ctld_port, d_port = free_ports(2)
     c.conf.write_text(f"""# written by tests/python/test_slurm.py
@@ -195,7 +194,9 @@ MailProg=/bin/true
 SchedulerParameters=sched_interval=2
 MinJobAge=3600
 KillWait=30
-NodeName={host} NodeAddr=127.0.0.1 CPUs={cpus} RealMemory={mem_mb} State=UNKNOWN
+# both tasks at once even on a 1-core machine (the test pauses both runs before it interrupts them)
+SlurmdParameters=config_overrides
+NodeName={host} NodeAddr=127.0.0.1 CPUs=2 RealMemory={mem_mb} State=UNKNOWN
 PartitionName=test Nodes={host} Default=YES MaxTime=INFINITE State=UP
 """)
     c.start("slurmctld", shutil.which("slurmctld") or "/usr/sbin/slurmctld", "-D", "-f", c.conf)
