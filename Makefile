@@ -174,7 +174,8 @@ figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 # CASES: only these runs (<case> or <case>_slow); then there is no figures job unless SLURM_THEN gives one.
 SLURM_DIR = $(RUNS)/$(PRESET)/slurm
 SLURM_CPUS ?= 1
-SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY PYTHON   # passed on to the jobs' make when given on the command line
+# passed on to the jobs' make when given on the command line
+SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY PYTHON
 slurm_opt = $(if $(2),'--$(1)=$(subst ','\'',$(2))')
 slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 	$(PYTHON) pipeline/slurm_jobs.py --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \

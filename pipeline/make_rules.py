@@ -48,5 +48,6 @@ def main():
     pathlib.Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     pathlib.Path(args.out).write_text("\n".join(lines) + "\n")
 
+
 if __name__ == "__main__":
     main()
