@@ -8,6 +8,11 @@
 #                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
 #                 number of cores). A run that was stopped continues from its checkpoint.
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
+#   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
+#                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
+#                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
+#                 time limit) and a figures job after it; submit with runs/<preset>/slurm/submit.sh (README:
+#                 Cluster runs)
 #   make vtk      [PRESET=...]  ParaView files (.pvd + .vtu series) of every finished run, in runs/<preset>/<case>/vtk/
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
@@ -29,7 +34,8 @@ RUN_SET ?=
 # Debian packages: the complete set needed to build, test and draw figures.
 DEB_PACKAGES := g++ make cmake pkg-config git \
   libeigen3-dev libsuitesparse-dev libhdf5-dev libtomlplusplus-dev libcli11-dev libgtest-dev \
-  python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest python3-vtk9
+  python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest python3-vtk9 \
+  slurm-wlm munge
 
 # An interpreter that can import the pipeline's modules. The `python3` first on PATH may be a
 # pyenv one without them, so probe the Debian interpreter first; fall back to it (after
@@ -48,7 +54,7 @@ RUNS := runs
 FIG_OUT := figures/out/$(PRESET)
 
 .PHONY: bench bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all vtk \
-  reference clean-runs check-preset
+  reference clean-runs check-preset slurm
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -166,6 +172,23 @@ figures: check-preset
 figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 	@test -n "$(FIGURES)" || { echo "figures: no figure list ($(BUILD_DIR)/figures.mk could not be made with PYTHON=$(PYTHON)); run 'make deps' first" >&2; exit 1; }
 	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
+
+# SLURM: job scripts for the runs of the figure set (pipeline/slurm_jobs.py --help). Every task and the figures
+# job run make with the variables below, never rebuilding the solver (-o): it is built here first.
+# CASES: only these runs (<case> or <case>_slow); then there is no figures job unless SLURM_THEN gives one.
+SLURM_DIR = $(RUNS)/$(PRESET)/slurm
+SLURM_CPUS ?= 1
+# passed on to the jobs' make when given on the command line
+SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY PYTHON
+slurm_opt = $(if $(2),'--$(1)=$(subst ','\'',$(2))')
+slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
+	$(PYTHON) -m pipeline.slurm_jobs --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \
+	  --cpus $(SLURM_CPUS) $(call slurm_opt,partition,$(SLURM_PARTITION)) $(call slurm_opt,account,$(SLURM_ACCOUNT)) \
+	  $(call slurm_opt,time,$(SLURM_TIME)) $(call slurm_opt,mem,$(SLURM_MEM)) $(call slurm_opt,then,$(SLURM_THEN)) \
+	  $(call slurm_opt,signal-seconds,$(SLURM_SIGNAL)) \
+	  $(call slurm_opt,run-set,$(RUN_SET)) $(foreach o,$(SLURM_SBATCH),$(call slurm_opt,sbatch,$(o))) \
+	  $(foreach v,$(SLURM_PASS),$(if $(filter command line,$(origin $(v))),$(call slurm_opt,make-var,$(v)=$($(v))))) \
+	  $(if $(CASES),--cases $(CASES)) $(if $(filter command line,$(origin CASES)),$(if $(CASES),,--cases))
 
 # ParaView: one .pvd + .vtu time series per finished run (rods and interfaces), in runs/<preset>/<case>/vtk/.
 vtk: check-preset

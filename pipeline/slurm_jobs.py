@@ -1,0 +1,279 @@
+#!/usr/bin/env python3
+"""Write SLURM job scripts for the runs of the figure set: a job array with one task per run, and a figures job
+that starts once every task has succeeded (standard library only; `make slurm` calls it).
+
+    python3 -m pipeline.slurm_jobs --preset P [--cases RUN ...] [--partition X --time T --mem M ...]
+
+writes OUT/runs.sbatch, OUT/figures.sbatch and OUT/submit.sh (OUT defaults to RUNS/P/slurm) and prints what
+it wrote; run OUT/submit.sh on the cluster's login node to submit both (it prints the job ids).
+
+Each array task builds its runs/P/<run>/result.h5 with `make` through the same Make rule as `make runs`, so a
+task that starts again continues its run from the run's checkpoint. The runs are the figure set's cases and
+their half-rate `<case>_slow` twins (paper_cases/figures.toml, as make_rules.py reads it); --cases keeps some.
+
+Signals. Before the time limit SLURM sends the batch shell SIGUSR1 (--signal-seconds ahead); the shell passes
+SIGTERM to the process group of make and the solver, the solver writes a checkpoint and exits, and the task
+requeues itself (`scontrol requeue`): its next start continues the run. A SIGTERM from SLURM (scancel,
+`scontrol requeue`, preemption) also reaches the solver, which writes its checkpoint before SLURM's KillWait
+ends; a requeued task continues, a cancelled one continues when submitted again.
+
+Resources (every task of an array gets the same): memory is the largest of the solver's own estimates
+(`enamel-dem info --estimate`) over the runs, x1.25 + 256 MB; time is the bench's cost model for one core:
+steps x DOF / (DOF-updates per second), with the steps of a whole run and the DOF-updates/s of the `lumped`
+scheme at the nearest measured size in bench/cost_growth.csv (its estimate at loading rate 1e-3 c_d, the
+slowest preset rate; x2 for half-rate twins), x2, between 10 min and 24 h (a common partition limit). A task
+that reaches its time limit is requeued and continues, so an estimate that is too short costs a wait in the
+queue, not work. --mem and --time replace the estimates.
+"""
+import argparse
+import concurrent.futures
+import csv
+import math
+import os
+import pathlib
+import shlex
+import subprocess
+import sys
+
+from enamel_results import paths  # the one place that defines paths
+from pipeline.make_rules import figure_set  # the one place that lists the runs
+
+
+PROG = "slurm_jobs.py"
+MEM_FACTOR, MEM_EXTRA_MB = 1.25, 256     # memory request: solver estimate x1.25 + 256 MB (make, shell, HDF5)
+TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: cost-model estimate x2, 10 min to 24 h
+COST_CSV = paths.BENCH / "cost_growth.csv"
+
+
+class EstimateError(Exception):
+    pass
+
+
+def fail(msg: str) -> None:
+    print(f"{PROG}: {msg}", file=sys.stderr)
+    sys.exit(2)
+
+
+def select_runs(cases: list[str] | None) -> list[str]:
+    """Run names (case, or case_slow for a half-rate twin) of the figure set, or the given subset of them."""
+    _, all_cases, all_slow = figure_set()
+    runs = all_cases + [f"{c}_slow" for c in all_slow]
+    if not runs:
+        fail(f"{paths.FIGURE_LIST} lists no runs")
+    if cases is None:
+        return runs
+    unknown = [c for c in cases if c not in runs]
+    if unknown:
+        fail(f"'{unknown[0]}' is not a run of the figure set ({paths.FIGURE_LIST}: a case, or <case>_slow for "
+             "a half-rate twin)")
+    if not cases:
+        fail("--cases given without any run")
+    return list(dict.fromkeys(cases))
+
+
+def run_sets(run: str, run_set: list[str]) -> list[str]:
+    """The --set arguments of one run, as the Make rule passes them: the twin's rate_factor, then RUN_SET's."""
+    sets = ["--set", "rate_factor=0.5"] if run.endswith("_slow") else []
+    for kv in run_set:
+        sets += ["--set", kv]
+    return sets
+
+
+def case_of(run: str) -> str:
+    return run[:-len("_slow")] if run.endswith("_slow") else run
+
+
+def estimate(solver: pathlib.Path, preset: str, run: str, run_set: list[str]) -> dict:
+    """The solver's estimate of one run without building it: {'dof': int, 'memory_mb': int}."""
+    cmd = [str(solver), "info", str(paths.case_file(case_of(run))), "--preset", preset,
+           *run_sets(run, run_set), "--estimate"]
+    try:
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    except OSError as e:
+        raise EstimateError(f"cannot run the solver {solver} ({e}): run `make build`")
+    out = {}
+    for line in r.stdout.splitlines():
+        parts = line.split()
+        if len(parts) == 2 and parts[0] in ("dof", "memory_mb"):
+            out[parts[0]] = int(float(parts[1]))
+    if r.returncode != 0 or len(out) != 2:
+        why = (r.stderr.strip().splitlines() or ["no 'dof' and 'memory_mb' lines"])[0]
+        raise EstimateError(f"`{' '.join(cmd[1:])}`: {why}")
+    return out
+
+
+def cost_rows(csv_path: pathlib.Path = COST_CSV) -> list[dict]:
+    """bench/cost_growth.csv rows of the lumped scheme at h_e = 0.3 d that carry a whole-run estimate."""
+    with open(csv_path) as f:
+        rows = [r for r in csv.DictReader(f) if r.get("integrator") == "lumped" and r.get("status") == "completed"
+                and r.get("est_steps_per_run_at_1e-3") and math.isclose(float(r["h_e"]), 0.3)]
+    if not rows:
+        fail(f"{csv_path} has no completed lumped row with est_steps_per_run_at_1e-3 (run `make bench`), "
+             "or give --time")
+    return rows
+
+
+def estimate_seconds(dof: int, slow: bool, rows: list[dict]) -> float:
+    """One core's wall time of a whole run: steps x DOF / (DOF-updates/s) at the nearest measured size."""
+    row = min(rows, key=lambda r: abs(math.log(float(r["dof"]) / dof)))
+    steps = float(row["est_steps_per_run_at_1e-3"]) * (2 if slow else 1)
+    return float(row["setup_s"]) * dof / float(row["dof"]) + steps * dof / float(row["dof_updates_per_s"])
+
+
+def slurm_time(seconds: float) -> str:
+    """SLURM's days-hours:minutes:seconds, rounded up to whole minutes."""
+    m = math.ceil(seconds / 60)
+    return f"{m // 1440}-{m // 60 % 24:02d}:{m % 60:02d}:00"
+
+
+def quote_vars(make_vars: list[str]) -> str:
+    return " ".join(shlex.quote(v) for v in make_vars)
+
+
+def sbatch_lines(opts: dict) -> str:
+    return "".join(f"#SBATCH --{k}={v}\n" if v is not None else f"#SBATCH --{k}\n" for k, v in opts.items())
+
+
+ARRAY_BODY = r"""
+targets=(
+{targets})
+target=${{targets[$SLURM_ARRAY_TASK_ID]}}
+export OMP_THREAD_LIMIT=${{SLURM_CPUS_PER_TASK:-1}}   # the solver's automatic thread count stays in the allocation
+unset MAKEFLAGS MFLAGS MAKELEVEL   # a make of its own, whatever the submitting shell was
+say() {{ echo "$(date '+%F %T') task $SLURM_ARRAY_TASK_ID (job $SLURM_JOB_ID): $*"; }}
+say "start $((${{SLURM_RESTART_COUNT:-0}} + 1)) on $(hostname): make $target"
+
+# make runs as a job of its own (set -m: its own process group), so that a signal reaches the solver: make
+# passes SIGTERM only to its recipe's shell, which dies without passing it on.
+set -m
+{make} "$target" &
+group=$!
+requeue=no
+trap 'say "time limit in {signal_s} s or less: stopping the run at a checkpoint, then requeueing"; requeue=yes
+      kill -TERM -- -$group 2>/dev/null' USR1
+trap 'say "SIGTERM (cancelled, requeued or preempted): stopping the run at a checkpoint"
+      kill -TERM -- -$group 2>/dev/null' TERM
+wait $group; rc=$?
+while kill -0 $group 2>/dev/null; do wait $group; rc=$?; done   # a trap ended the wait early: wait again
+while kill -0 -- -$group 2>/dev/null; do sleep 1; done          # the solver may still be writing its checkpoint
+if [ $requeue = yes ] && [ $rc != 0 ]; then
+  say "requeueing: the next start continues from the checkpoint"
+  trap '' TERM   # SLURM ends this start at once: let scontrol (which inherits this) finish
+  # the task's own id: $SLURM_JOB_ID of the array's last task is the array's id (it would requeue every task)
+  scontrol requeue "${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}" && exit 0
+  say "scontrol requeue failed: submit again to continue from the checkpoint"
+fi
+say "make exited with status $rc"
+exit $rc
+"""
+
+SUBMIT = r"""#!/bin/bash
+# Submit the runs of preset {preset} (written by pipeline/slurm_jobs.py): the job array, then the figures job.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+array=$(sbatch --parsable "$here/runs.sbatch"); array=${{array%%;*}}
+echo "array $array: {n} runs of preset {preset}; logs $here/logs/run-${{array}}_<task>.out"
+{figures}"""
+
+SUBMIT_FIGURES = r"""figures=$(sbatch --parsable --dependency=afterok:$array "$here/figures.sbatch")
+figures=${{figures%%;*}}
+echo "figures $figures:" {then} "once every task of $array has succeeded; log $here/logs/figures-$figures.out"
+"""
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--preset", required=True, help="preset of the runs (ci, reduced, paper)")
+    ap.add_argument("--cases", nargs="*", metavar="RUN", default=None,
+                    help="only these runs of the figure set (<case> or <case>_slow); with --cases there is no "
+                         "figures job unless --then gives one")
+    ap.add_argument("--runs", default="runs", help="root of the runs, as Make's RUNS (default: runs)")
+    ap.add_argument("--out", type=pathlib.Path, default=None, help="where the scripts go (default RUNS/PRESET/slurm)")
+    ap.add_argument("--solver", type=pathlib.Path, default=paths.SOLVER,
+                    help=f"the solver binary, as Make's ENAMEL (default {paths.SOLVER}); the jobs never rebuild it")
+    ap.add_argument("--make-var", action="append", default=[], metavar="NAME=VALUE",
+                    help="a Make variable for every make command of the jobs (repeatable), e.g. CHECKPOINT_EVERY=60")
+    ap.add_argument("--run-set", default="", help="Make's RUN_SET: 'key=value ...' --set overrides of every run "
+                    "(they also go into the estimates)")
+    ap.add_argument("--then", default=None,
+                    help="command of the figures job (default: make figures PRESET=P with the same variables; "
+                         "'none': no figures job)")
+    ap.add_argument("--cpus", type=int, default=1, help="CPUs per task (default 1); the solver uses at most these")
+    ap.add_argument("--mem", default=None, help="memory per task, SLURM syntax (default: the solver's estimate)")
+    ap.add_argument("--time", default=None, help="time limit per task start, SLURM syntax (default: the estimate)")
+    ap.add_argument("--figures-time", default="1:00:00", help="time limit of the figures job (default 1:00:00)")
+    ap.add_argument("--figures-mem", default="4G", help="memory of the figures job (default 4G)")
+    ap.add_argument("--partition", default=None, help="SLURM partition (default: the cluster's default)")
+    ap.add_argument("--account", default=None, help="SLURM account (default: none given)")
+    ap.add_argument("--sbatch", action="append", default=[], metavar="OPTION",
+                    help="another #SBATCH option for both jobs (repeatable), e.g. --sbatch=--qos=long")
+    ap.add_argument("--signal-seconds", type=int, default=300,
+                    help="SIGUSR1 this many seconds before the time limit: checkpoint and requeue (default 300)")
+    a = ap.parse_args(argv)
+
+    runs = select_runs(a.cases)
+    out = (a.out or pathlib.Path(a.runs) / a.preset / "slurm").resolve()
+    run_set = a.run_set.split()
+    make_vars = [f"PRESET={a.preset}", f"RUNS={a.runs}", *([f"RUN_SET={a.run_set}"] if run_set else []),
+                 *a.make_var]
+    make = f"make --no-print-directory -o {shlex.quote(str(a.solver))} {quote_vars(make_vars)}"
+
+    note = []
+    # the estimates (with --mem and --time given, one: it checks the solver, the preset and RUN_SET)
+    try:
+        with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 2) as pool:
+            todo = runs if a.mem is None or a.time is None else runs[:1]
+            est = dict(zip(todo, pool.map(lambda r: estimate(a.solver, a.preset, r, run_set), todo)))
+    except EstimateError as e:
+        fail(str(e))    # one line, whichever run failed first
+    if a.mem is None:
+        mb = max(e["memory_mb"] for e in est.values())
+        a.mem = f"{math.ceil((mb * MEM_FACTOR + MEM_EXTRA_MB) / 100) * 100}M"
+        note.append(f"--mem {a.mem} (solver estimate {mb} MB, largest run)")
+    if a.time is None:
+        rows = cost_rows()
+        s = max(estimate_seconds(e["dof"], r.endswith("_slow"), rows) for r, e in est.items())
+        a.time = slurm_time(min(TIME_MAX_S, max(TIME_MIN_S, TIME_FACTOR * s)))
+        note.append(f"--time {a.time} (cost model {s / 3600:.2g} h on one core, longest run)")
+
+    common = {"partition": a.partition, "account": a.account}
+    common = {k: v for k, v in common.items() if v}
+    extra = "".join(f"#SBATCH {o}\n" for o in a.sbatch)
+    logs = out / "logs"
+    targets = [str(paths.result_file(a.preset, case_of(r), r.endswith("_slow"), runs=pathlib.Path(a.runs)))
+               for r in runs]
+    array = {"job-name": f"enamel-{a.preset}-runs", "array": f"0-{len(runs) - 1}", "chdir": str(paths.ROOT),
+             "output": str(logs / "run-%A_%a.out"), "open-mode": "append", "requeue": None,
+             "signal": f"B:USR1@{a.signal_seconds}", "cpus-per-task": a.cpus, "mem": a.mem, "time": a.time,
+             **common}
+    header = (f"#!/bin/bash\n# Written by pipeline/slurm_jobs.py: preset {a.preset}, {len(runs)} runs; "
+              f"submit with {out / 'submit.sh'}\n")
+    body = ARRAY_BODY.format(targets="".join(f"  {shlex.quote(t)}   # task {i}\n" for i, t in enumerate(targets)),
+                             make=make, signal_s=a.signal_seconds)
+    out.mkdir(parents=True, exist_ok=True)
+    logs.mkdir(exist_ok=True)
+    (out / "runs.sbatch").write_text(header + sbatch_lines(array) + extra + body)
+
+    then = a.then if a.then is not None else ("none" if a.cases is not None else f"{make} figures-all")
+    figures_part = ""
+    if then != "none":
+        fig = {"job-name": f"enamel-{a.preset}-figures", "chdir": str(paths.ROOT),
+               "output": str(logs / "figures-%j.out"), "kill-on-invalid-dep": "yes", "cpus-per-task": 1,
+               "mem": a.figures_mem, "time": a.figures_time, **common}
+        (out / "figures.sbatch").write_text(
+            header + sbatch_lines(fig) + extra +
+            f'\necho "$(date \'+%F %T\') figures (job $SLURM_JOB_ID) on $(hostname):" {shlex.quote(then)}\n{then}\n'
+            'rc=$?\necho "$(date \'+%F %T\') figures: exit status $rc"\nexit $rc\n')
+        figures_part = SUBMIT_FIGURES.format(then=shlex.quote(then))
+    else:
+        (out / "figures.sbatch").unlink(missing_ok=True)
+    submit = out / "submit.sh"
+    submit.write_text(SUBMIT.format(preset=a.preset, n=len(runs), figures=figures_part))
+    submit.chmod(0o755)
+    print(f"{PROG}: {out}/: runs.sbatch ({len(runs)} array tasks, {', '.join(note) or 'resources as given'})"
+          + (", figures.sbatch" if figures_part else ", no figures job") + f"; submit with {submit}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
