@@ -6,6 +6,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -60,10 +61,11 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   if (int rc = checkMemory(p)) return rc;
   Simulation sim(p);
   const Model& m = sim.model;
+  const Materials& mat = sim.materials;
   int byTag[4] = {0, 0, 0, 0};
   for (auto t : m.ifaceTag) ++byTag[t];
-  const double wAxial = beam::closedFormAxialOmegaMax(sim.section, m.beamLength);
-  const double wBend = beam::closedFormBendingOmegaMax(sim.section, m.beamLength, sim.section.Iy);
+  const double wAxial = beam::closedFormAxialOmegaMax(mat.section, m.beamLength);
+  const double wBend = beam::closedFormBendingOmegaMax(mat.section, m.beamLength, mat.section.Iy);
   std::printf("case               %s%s%s\n", p.sourceName.c_str(), p.presetName.empty() ? "" : "  preset ",
               p.presetName.c_str());
   std::printf("theta_D            %g deg   Er/kd %g   sigma_ru/sigma0 %g   cv %g\n", p.theta_D, p.Er_over_kd,
@@ -72,19 +74,19 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   std::printf("slices             %d (h_e %.4f d)\n", m.numSlices, m.h_e);
   std::printf("rods               %d\n", m.numRods());
   std::printf("nodes              %d\n", m.numNodes());
-  std::printf("DOF                %d (6 per node), %zu prescribed\n", m.numDofs(), sim.prescribedDofs.size());
+  std::printf("DOF                %d (6 per node), %zu prescribed\n", m.numDofs(), sim.ops.prescribedDofs.size());
   std::printf("beam elements      %d (+%d cut by the pre-crack), length %.4f d\n", m.numBeams(), m.precrackBeams,
               m.beamLength);
   std::printf("interfaces         %d (+%d cut by the pre-crack)\n", m.numInterfaces(), m.precrackInterfaces);
   for (int t = 0; t < 4; ++t) std::printf("  %-30s %d\n", interfaceTagName(t), byTag[t]);
   std::printf("element frequency  omega_max %.4g c_r/d: %s governs (bending %.4g, axial %.4g)\n",
-              sim.omegaMaxElement, wBend > wAxial ? "bending" : "axial", wBend, wAxial);
+              mat.omegaMaxElement, wBend > wAxial ? "bending" : "axial", wBend, wAxial);
   std::printf("time step          dt %.4g d/c_r (integrator %s)\n", sim.integrator->timeStep(),
               sim.integrator->describe().c_str());
-  std::printf("transverse modulus E_transverse %.4g E_r, c_d %.4g c_r%s\n", sim.E_transverse, sim.c_d,
+  std::printf("transverse modulus E_transverse %.4g E_r, c_d %.4g c_r%s\n", mat.E_transverse, mat.c_d,
               p.E_transverse_over_Er > 0 ? " (given)" : " (measured)");
-  std::printf("damping            zeta %g at w_min %.4g: a %.4g, b %.4g\n", p.zeta, sim.omegaMin, sim.dampA, sim.dampB);
-  std::printf("loading            v_app %.4g d c_r/d, ramp %.4g d/c_r\n", sim.loading.vApp, sim.loading.rampTime);
+  std::printf("damping            zeta %g at w_min %.4g: a %.4g, b %.4g\n", p.zeta, mat.omegaMin, mat.dampA, mat.dampB);
+  std::printf("loading            v_app %.4g d c_r/d, ramp %.4g d/c_r\n", mat.loading.vApp, mat.loading.rampTime);
   std::printf("memory estimate    %.0f MB (%s)\n", estimateResources(p).memoryBytes / 1048576,
               "enamel-dem info --estimate; a run refuses a case that needs more than is available");
   return exit_code::ok;
@@ -159,6 +161,8 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   opt.checkpointPath = checkpointPath;
   opt.checkpointIntervalSeconds = flags.checkpointEvery >= 0 ? flags.checkpointEvery : p.checkpoint_interval_s;
   opt.restart = restart;
+  // Fault injection for the tests of the failure path (tests/python/test_cli.py).
+  if (const char* inject = std::getenv("ENAMEL_INJECT_NAN_AT_STEP")) opt.injectNanAtStep = std::atol(inject);
   const RunRecord rec = runSimulation(sim, opt);
   const RcurveSummary s = [&] {
     std::vector<double> R;
@@ -168,7 +172,7 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   std::fprintf(stderr, "enamel-dem: %s: %s after %ld steps, %.1f s: %s\n", p.sourceName.c_str(), rec.status.c_str(),
                rec.steps, rec.wallSeconds, rec.stopReason.c_str());
   std::fprintf(stderr, "enamel-dem: R_init/Gamma %.4g  R_ss/Gamma %.4g  da_max/d %.3g  broken rods %d  energy balance %.3g\n",
-               s.R_init, s.R_ss, s.daMax, sim.state.brokenBeams,
+               s.R_init, s.R_ss, s.daMax, sim.state.brokenBeams(),
                rec.history.empty() ? 0.0 : rec.history.back().balanceError);
   for (const auto& w : rec.warnings) std::fprintf(stderr, "enamel-dem: warning: %s\n", w.c_str());
   if (rec.status == "failed")
@@ -237,16 +241,8 @@ int main(int argc, char** argv) {
     if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
     if (*info) return runInfo(infoArgs, estimateOnly);
     if (*run) return runRun(runArgs, flags);
-  } catch (const CaseError& e) {
-    return fail(e.exitCode, e.what());
-  } catch (const CheckpointError& e) {
-    return fail(exit_code::checkpoint_invalid, e.what());
-  } catch (const IntegratorError& e) {
-    return fail(exit_code::out_of_range, e.what());
-  } catch (const std::invalid_argument& e) {
-    return fail(exit_code::out_of_range, e.what());
   } catch (const std::exception& e) {
-    return fail(exit_code::run_failed, e.what());
+    return fail(exitCodeOf(e), e.what());
   }
   return exit_code::usage;
 }

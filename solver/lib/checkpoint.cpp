@@ -14,7 +14,8 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 2;  // 2: the header carries the build fingerprint
+constexpr std::uint32_t kVersion = 3;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+                                       // and the reactions, frames the rod stress
 
 struct Writer {
   std::ofstream out;
@@ -30,6 +31,11 @@ struct Writer {
   }
   void vec(const VecX& v) { vec(std::vector<double>(v.data(), v.data() + v.size())); }
   void str(const std::string& s) { vec(std::vector<char>(s.begin(), s.end())); }
+  template <class T, class F>
+  void items(const std::vector<T>& v, F each) {  // a count, then each item
+    pod(static_cast<std::uint64_t>(v.size()));
+    for (const T& x : v) each(x);
+  }
 };
 
 struct Reader {
@@ -49,7 +55,8 @@ struct Reader {
     if (n) in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
     if (!in) throw CheckpointError("checkpoint '" + path + "' is truncated");
   }
-  void vec(VecX& v, Eigen::Index expected) {
+  void vec(VecX& v) {  // the size the freshly built state has
+    const Eigen::Index expected = v.size();
     std::vector<double> tmp;
     vec(tmp);
     if (static_cast<Eigen::Index>(tmp.size()) != expected)
@@ -62,7 +69,37 @@ struct Reader {
     vec(tmp);
     s.assign(tmp.begin(), tmp.end());
   }
+  template <class T, class F>
+  void items(std::vector<T>& v, F each) {
+    std::uint64_t n = 0;
+    pod(n);
+    if (n > (1ULL << 34)) throw CheckpointError("checkpoint '" + path + "' is corrupt (list of " + std::to_string(n) + ")");
+    v.resize(n);
+    for (T& x : v) each(x);
+  }
 };
+
+// Every field a checkpoint holds, in file order: one list for writing (Io = Writer, const State and
+// RunRecord) and reading (Io = Reader). The case and the header are written before it.
+template <class Io, class S, class R>
+void transferFields(Io& io, S& s, R& rec) {
+  io.pod(s.step); io.pod(s.time); io.pod(s.appliedDisplacement);
+  io.vec(s.q); io.vec(s.v); io.vec(s.a); io.vec(s.vHalf); io.vec(s.reaction);
+  io.vec(s.lambdaMax); io.vec(s.beamBroken); io.vec(s.deletionOrder);
+  io.pod(s.externalWork); io.pod(s.dampingWork); io.pod(s.rodFractureEnergy); io.pod(s.lastExternalPower);
+  io.pod(s.failedInterfaces); io.pod(s.crackAdvance);
+  io.vec(rec.history);  // Measurement is plain data
+  io.vec(rec.rcurveDa); io.vec(rec.rcurveJ);
+  io.items(rec.frames, [&](auto& f) {
+    io.pod(f.targetDa); io.pod(f.da); io.pod(f.step); io.pod(f.time); io.pod(f.appliedDisplacement);
+    io.vec(f.nodeDisplacement); io.vec(f.ifaceDamage); io.vec(f.ifaceState); io.vec(f.beamBroken);
+    io.vec(f.beamStress);
+  });
+  io.str(rec.status); io.str(rec.stopReason);
+  io.pod(rec.wallSeconds); io.pod(rec.steps); io.pod(rec.maxKineticRatio);
+  io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic);
+  io.items(rec.warnings, [&](auto& w) { io.str(w); });
+}
 
 // The effective case without its comment lines (the source file as given, the preset, the --set options): the
 // same case given by another path, or with a --set that repeats the value it has anyway, is the same case.
@@ -133,25 +170,7 @@ void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRe
     w.pod(kVersion);
     w.str(buildFingerprint());
     w.str(sim.params.tomlText);
-    const State& s = sim.state;
-    w.pod(s.step); w.pod(s.time); w.pod(s.appliedDisplacement);
-    w.vec(s.q); w.vec(s.v); w.vec(s.a);
-    w.vec(s.lambdaMax); w.vec(s.beamBroken); w.vec(s.deletionOrder);
-    w.pod(s.externalWork); w.pod(s.dampingWork); w.pod(s.rodFractureEnergy); w.pod(s.lastExternalPower);
-    w.pod(s.brokenBeams); w.pod(s.failedInterfaces); w.pod(s.crackAdvance);
-    w.vec(sim.reaction);
-    w.vec(rec.history);  // Measurement is plain data
-    w.vec(rec.rcurveDa); w.vec(rec.rcurveJ);
-    w.pod(static_cast<std::uint64_t>(rec.frames.size()));
-    for (const Frame& f : rec.frames) {
-      w.pod(f.targetDa); w.pod(f.da); w.pod(f.step); w.pod(f.time); w.pod(f.appliedDisplacement);
-      w.vec(f.nodeDisplacement); w.vec(f.ifaceDamage); w.vec(f.ifaceState); w.vec(f.beamBroken);
-    }
-    w.str(rec.status); w.str(rec.stopReason);
-    w.pod(rec.wallSeconds); w.pod(rec.steps); w.pod(rec.maxKineticRatio);
-    w.pod(rec.warnedBalance); w.pod(rec.warnedKinetic);
-    w.pod(static_cast<std::uint64_t>(rec.warnings.size()));
-    for (const auto& s2 : rec.warnings) w.str(s2);
+    transferFields(w, sim.state, rec);
     w.out.write(kMagic, sizeof kMagic);  // trailer: a complete file ends with the magic again
     w.out.flush();
     if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "' (disk full?)");
@@ -164,32 +183,10 @@ void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
   Reader r{std::ifstream(path, std::ios::binary), path};
   readHeader(r, sim.params.tomlText);
   State& s = sim.state;
-  const Eigen::Index n = sim.model.numDofs();
-  r.pod(s.step); r.pod(s.time); r.pod(s.appliedDisplacement);
-  r.vec(s.q, n); r.vec(s.v, n); r.vec(s.a, n);
-  r.vec(s.lambdaMax); r.vec(s.beamBroken); r.vec(s.deletionOrder);
+  transferFields(r, s, rec);
   if (s.lambdaMax.size() != static_cast<std::size_t>(sim.model.numInterfaces()) ||
       s.beamBroken.size() != static_cast<std::size_t>(sim.model.numBeams()))
     throw CheckpointError("checkpoint '" + path + "' does not fit this model");
-  r.pod(s.externalWork); r.pod(s.dampingWork); r.pod(s.rodFractureEnergy); r.pod(s.lastExternalPower);
-  r.pod(s.brokenBeams); r.pod(s.failedInterfaces); r.pod(s.crackAdvance);
-  r.vec(sim.reaction, static_cast<Eigen::Index>(sim.prescribedDofs.size()));
-  r.vec(rec.history);
-  r.vec(rec.rcurveDa); r.vec(rec.rcurveJ);
-  std::uint64_t nf = 0;
-  r.pod(nf);
-  rec.frames.resize(nf);
-  for (Frame& f : rec.frames) {
-    r.pod(f.targetDa); r.pod(f.da); r.pod(f.step); r.pod(f.time); r.pod(f.appliedDisplacement);
-    r.vec(f.nodeDisplacement); r.vec(f.ifaceDamage); r.vec(f.ifaceState); r.vec(f.beamBroken);
-  }
-  r.str(rec.status); r.str(rec.stopReason);
-  r.pod(rec.wallSeconds); r.pod(rec.steps); r.pod(rec.maxKineticRatio);
-  r.pod(rec.warnedBalance); r.pod(rec.warnedKinetic);
-  std::uint64_t nw = 0;
-  r.pod(nw);
-  rec.warnings.resize(nw);
-  for (auto& w : rec.warnings) r.str(w);
   char magic[8];
   r.in.read(magic, sizeof magic);
   if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)

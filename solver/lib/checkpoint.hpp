@@ -25,7 +25,7 @@ const std::string& buildFingerprint();
 /// for this effective case: what --resume asks before it continues a run. Reads only the header.
 void checkCheckpoint(const std::string& path, const CaseParams& params);
 
-/// Write sim.state, sim.reaction and rec to `path` atomically. Throws CheckpointError naming the path.
+/// Write sim.state (reactions included) and rec to `path` atomically. Throws CheckpointError naming the path.
 void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec);
 
 /// Restore a checkpoint written by writeCheckpoint for the same effective case into a freshly built sim

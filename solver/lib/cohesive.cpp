@@ -113,12 +113,19 @@ Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const 
   return -g.area * (g.frame.transpose() * tLocal);
 }
 
-// F_B as above, F_A = -F_B, M_A = rA x F_A, M_B = rB x F_B
+// B: (F_B, rB x F_B);  A: F_A = -F_B, (F_A, rA x F_A)
+Wrench wrenchOnSide(const InterfaceGeometry& g, const Vec3& forceOnB, bool sideB) {
+  if (sideB) return Wrench{forceOnB, g.armB.cross(forceOnB)};
+  const Vec3 forceA = -forceOnB;
+  return Wrench{forceA, g.armA.cross(forceA)};
+}
+
+// F_B as above, then the wrench on each side
 NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                                    const Vec3& uB, const Vec3& thB, double& lambdaMax) {
   const Vec3 forceB = computeInterfaceForceOnB(law, g, uA, thA, uB, thB, lambdaMax);
-  const Vec3 forceA = -forceB;
-  return NodalWrench{forceA, g.armA.cross(forceA), forceB, g.armB.cross(forceB)};
+  const Wrench onA = wrenchOnSide(g, forceB, false), onB = wrenchOnSide(g, forceB, true);
+  return NodalWrench{onA.force, onA.moment, onB.force, onB.moment};
 }
 
 // delta = Bq with B = [-I, [rA]x, I, -[rB]x] (theta x r = -[r]x theta), q = (uA, thA, uB, thB);

@@ -67,14 +67,19 @@ Mat3 makeFrame(const Vec3& normal);
 Vec3 computeOpening(const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA, const Vec3& uB, const Vec3& thB);
 
 struct NodalWrench { Vec3 forceA, momentA, forceB, momentB; };  // forces/moments exerted ON the nodes
+struct Wrench { Vec3 force, moment; };
 
-// Force on B = -area * frame^T * t_local; force on A = minus that; moments = arm x force.
+// Force on B = -area * frame^T * t_local; force on A = minus that; moments = arm x force
+// (computeInterfaceForceOnB, then wrenchOnSide for each side: what the solver's gather calls).
 NodalWrench computeInterfaceForces(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                                    const Vec3& uB, const Vec3& thB, double& lambdaMax);
 
 // The force on B alone: all an interface needs to store, since F_A = -F_B and the moments are arm x force.
 Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const Vec3& uA, const Vec3& thA,
                               const Vec3& uB, const Vec3& thB, double& lambdaMax);
+
+// The wrench on one node from the force on B: on B (F_B, r_B x F_B), on A (F_A = -F_B, r_A x F_A).
+Wrench wrenchOnSide(const InterfaceGeometry& g, const Vec3& forceOnB, bool sideB);
 
 // Linearised (undamaged, elastic) interface stiffness 12x12 in the DOF order (uA, thA, uB, thB), k*area with
 // the rigid arms; used only to estimate frequencies / transverse modulus, never in the time loop.

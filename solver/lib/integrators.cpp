@@ -6,9 +6,12 @@
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
+
+#include "kernels.hpp"
 
 namespace enamel {
 
@@ -27,111 +30,154 @@ SpMat selectRows(const SpMat& A, const std::vector<int>& rows) {
   return S;
 }
 
-// The paper's scheme (eq. 12-15): Newmark beta = 0 with consistent mass and Rayleigh damping,
-//   q_{n+1} = q_n + dt v_n + dt^2/2 a_n
-//   H a_{n+1} = f - f_iface(q_{n+1}) - K q_{n+1} - C (v_n + dt/2 a_n),   H = M + dt/2 C
-//   v_{n+1} = v_n + dt/2 (a_n + a_{n+1})
+// --- pieces of a step that both schemes use -------------------------------------------------------------
+// t_{n+1} = t_n + dt, n + 1
+void advanceClock(State& s, double dt) {
+  s.time += dt;
+  ++s.step;
+}
+
+// The prescribed DOFs' entries of a vector indexed by DOF.
+void gatherGrips(const Operators& ops, const VecX& x, VecX& atGrips) {
+  atGrips.resize(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) atGrips[i] = x[ops.prescribedDofs[i]];
+}
+
+// P = sum_p R_p v_p: the power of the grips (summed in the order of the prescribed DOFs)
+double computeGripPower(const VecX& reaction, const VecX& gripVelocity) {
+  double power = 0;
+  for (Eigen::Index i = 0; i < reaction.size(); ++i) power += reaction[i] * gripVelocity[i];
+  return power;
+}
+
+// W_ext += dt/2 (P_prev + P): trapezoid rule over the interval that ends where P was taken (none when
+// `intervalEnds` is false: the first reactions of `lumped`, at t_0); P is kept for the next interval.
+void addWorkOfGrips(State& s, double power, double dt, bool intervalEnds = true) {
+  if (intervalEnds) s.externalWork += 0.5 * dt * (s.lastExternalPower + power);
+  s.lastExternalPower = power;
+}
+
+// The paper's scheme (eq. 12-15): Newmark beta = 0 with consistent mass and Rayleigh damping. One step:
+//   w       = v_n + dt/2 a_n                              (predicted velocity, where the damping acts)
+//   q_{n+1} = q_n + dt v_n + dt^2/2 a_n                   (positions)
+//   q, v, a of the grips at t_{n+1}                       (boundary conditions)
+//   f_iface(q_{n+1}), K q_{n+1}, C w = a M w + b K w      (forces for interfaces, for beams)
+//   H a_{n+1} = -f_iface - K q_{n+1} - C w,  H = M + dt/2 C   (accelerations)
+//   v_{n+1} = w + dt/2 a_{n+1}                            (velocities)
+//   W_damp += dt w . C w                                  (damping work)
+//   R_p = (M a + C v + K q + f_iface)_p at t_{n+1}; W_ext += dt/2 (P_n + P_{n+1})  (reactions, grips' work)
 // H is factorised once (CHOLMOD Cholesky, or UMFPACK LU) and re-factorised after rod deletions. Prescribed
 // DOFs are eliminated: H_ff a_f = r_f - H_fp a_p.
 class PaperIntegrator : public Integrator {
  public:
-  explicit PaperIntegrator(Simulation& sim) : useUmfpack_(sim.params.linear_solver == "umfpack") {
-    dt_ = sim.params.dt_factor * 2.0 * M_PI / sim.omegaMaxElement;
-    const double limit = 2.0 / sim.omegaMaxElement;
+  PaperIntegrator(const CaseParams& p, const Materials& mat, const Operators& ops)
+      : useUmfpack_(p.linear_solver == "umfpack"), dampA_(mat.dampA), dampB_(mat.dampB) {
+    dt_ = p.dt_factor * 2.0 * M_PI / mat.omegaMaxElement;
+    const double limit = 2.0 / mat.omegaMaxElement;
     // Interfaces add stiffness (about k A_i per node against E A / L for the beams): keep 5% margin.
     if (dt_ > 0.95 * limit) {
       std::ostringstream msg;
-      msg << "time step dt = " << dt_ << " (dt_factor " << sim.params.dt_factor
+      msg << "time step dt = " << dt_ << " (dt_factor " << p.dt_factor
           << " x smallest element period) is above the stable limit 0.95 x 2/omega_max = " << 0.95 * limit
-          << " (omega_max = " << sim.omegaMaxElement << "): use dt_factor <= "
-          << 0.95 * limit * sim.omegaMaxElement / (2 * M_PI);
+          << " (omega_max = " << mat.omegaMaxElement << "): use dt_factor <= "
+          << 0.95 * limit * mat.omegaMaxElement / (2 * M_PI);
       throw IntegratorError(msg.str());
     }
-    factorise(sim, true);
+    factorise(ops, true);
   }
 
   std::string name() const override { return "paper"; }
   double timeStep() const override { return dt_; }
 
-  void advance(Simulation& sim) override {
-    State& s = sim.state;
-    const double dt = dt_, a = sim.dampA, b = sim.dampB;
-    w_ = s.v + 0.5 * dt * s.a;
-    s.q += dt * s.v + 0.5 * dt * dt * s.a;
-    s.time += dt;
-    ++s.step;
-    sim.applyBoundaryConditions(s.time);
+  void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    predictVelocities(s);
+    advancePositions(s);
+    advanceClock(s, dt_);
+    applyBoundaryConditions(ops, mat.loading, s.time, s);
     fI_.resize(s.q.size());
-    sim.computeForcesForInterfaces(s.q, fI_, true);
-    Kq_ = sim.K * s.q;
-    Kw_ = sim.K * w_;
-    Mw_ = sim.M * w_;
-    r_ = -fI_ - Kq_ - b * Kw_ - a * Mw_;
-    const std::vector<int>& freeDofs = sim.freeDofs;
-    const std::vector<int>& pres = sim.prescribedDofs;
-    VecX ap(pres.size());
-    for (std::size_t i = 0; i < pres.size(); ++i) ap[i] = s.a[pres[i]];
-    rf_.resize(freeDofs.size());
-    for (std::size_t i = 0; i < freeDofs.size(); ++i) rf_[i] = r_[freeDofs[i]];
-    rf_ -= Hfp_ * ap;
-    af_ = useUmfpack_ ? VecX(lu_.solve(rf_)) : VecX(chol_.solve(rf_));
-    for (std::size_t i = 0; i < freeDofs.size(); ++i) {
-      const int dof = freeDofs[i];
-      s.a[dof] = af_[i];
-      s.v[dof] = w_[dof] + 0.5 * dt * af_[i];
-    }
-    // Work of the damping force over the step, at the mid-step velocity w.
-    s.dampingWork += dt * w_.dot(a * Mw_ + b * Kw_);
-    // Reactions: the force the grips apply, R_p = (M a + C v + K q + f_iface)_p.
-    sim.reaction = Mp_ * s.a + a * (Mp_ * s.v) + b * (Kp_ * s.v);
-    double power = 0;
-    for (std::size_t i = 0; i < pres.size(); ++i) {
-      sim.reaction[i] += Kq_[pres[i]] + fI_[pres[i]];
-      power += sim.reaction[i] * s.v[pres[i]];
-    }
-    s.externalWork += 0.5 * dt * (s.lastExternalPower + power);
-    s.lastExternalPower = power;
+    s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
+    computeForcesForBeams(ops, s);
+    solveAccelerations(ops, s);
+    advanceVelocities(ops, s);
+    addDampingWork(s);
+    computeReactions(ops, s);
+    gatherGrips(ops, s.v, vGrip_);
+    addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_);
   }
 
-  void initialise(Simulation& sim) override {
-    State& s = sim.state;
-    sim.applyBoundaryConditions(s.time);
+  void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    applyBoundaryConditions(ops, mat.loading, s.time, s);
     fI_.resize(s.q.size());
-    sim.computeForcesForInterfaces(s.q, fI_, false);
-    r_ = -fI_ - sim.K * s.q - sim.dampB * (sim.K * s.v) - sim.dampA * (sim.M * s.v);
-    VecX ap(sim.prescribedDofs.size());
-    for (std::size_t i = 0; i < ap.size(); ++i) ap[i] = s.a[sim.prescribedDofs[i]];
-    rf_.resize(sim.freeDofs.size());
-    for (std::size_t i = 0; i < sim.freeDofs.size(); ++i) rf_[i] = r_[sim.freeDofs[i]];
-    rf_ -= Hfp_ * ap;
-    af_ = useUmfpack_ ? VecX(lu_.solve(rf_)) : VecX(chol_.solve(rf_));
-    for (std::size_t i = 0; i < sim.freeDofs.size(); ++i) s.a[sim.freeDofs[i]] = af_[i];
+    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
+    r_ = -fI_ - ops.K * s.q - dampB_ * (ops.K * s.v) - dampA_ * (ops.M * s.v);
+    solveAccelerations(ops, s);
   }
 
-  void onBeamsDeleted(Simulation& sim) override { factorise(sim, false); }
+  void updateOperators(const Operators& ops) override { factorise(ops, false); }
 
-  double kineticEnergy(const Simulation& sim) const override {
-    return 0.5 * sim.state.v.dot(sim.M * sim.state.v);
-  }
+  double kineticEnergy(const Operators& ops, const State& s) const override { return 0.5 * s.v.dot(ops.M * s.v); }
 
  private:
-  void factorise(Simulation& sim, bool first) {
-    const SpMat H = (1.0 + 0.5 * dt_ * sim.dampA) * sim.M + (0.5 * dt_ * sim.dampB) * sim.K;
+  // w = v_n + dt/2 a_n
+  void predictVelocities(const State& s) { w_ = s.v + 0.5 * dt_ * s.a; }
+
+  // q_{n+1} = q_n + dt v_n + dt^2/2 a_n
+  void advancePositions(State& s) const { s.q += dt_ * s.v + 0.5 * dt_ * dt_ * s.a; }
+
+  // K q_{n+1}, and the damping force's parts K w, M w; r = -f_iface - K q - b K w - a M w
+  void computeForcesForBeams(const Operators& ops, const State& s) {
+    Kq_ = ops.K * s.q;
+    Kw_ = ops.K * w_;
+    Mw_ = ops.M * w_;
+    r_ = -fI_ - Kq_ - dampB_ * Kw_ - dampA_ * Mw_;
+  }
+
+  // H_ff a_f = r_f - H_fp a_p (a_p: the grips' accelerations, already prescribed)
+  void solveAccelerations(const Operators& ops, State& s) {
+    gatherGrips(ops, s.a, aGrip_);
+    rf_.resize(static_cast<Eigen::Index>(ops.freeDofs.size()));
+    for (std::size_t i = 0; i < ops.freeDofs.size(); ++i) rf_[i] = r_[ops.freeDofs[i]];
+    rf_ -= Hfp_ * aGrip_;
+    af_ = useUmfpack_ ? VecX(lu_.solve(rf_)) : VecX(chol_.solve(rf_));
+    for (std::size_t i = 0; i < ops.freeDofs.size(); ++i) s.a[ops.freeDofs[i]] = af_[i];
+  }
+
+  // v_{n+1} = w + dt/2 a_{n+1} (free DOFs; the grips' v is prescribed)
+  void advanceVelocities(const Operators& ops, State& s) const {
+    for (std::size_t i = 0; i < ops.freeDofs.size(); ++i) {
+      const int dof = ops.freeDofs[i];
+      s.v[dof] = w_[dof] + 0.5 * dt_ * af_[i];
+    }
+  }
+
+  // W_damp += dt w . (a M w + b K w): the damping force's work over the step, at the mid-step velocity w
+  void addDampingWork(State& s) const { s.dampingWork += dt_ * w_.dot(dampA_ * Mw_ + dampB_ * Kw_); }
+
+  // R_p = (M a + a M v + b K v + K q + f_iface)_p: the force the grips apply, at t_{n+1}
+  void computeReactions(const Operators& ops, State& s) const {
+    s.reaction = Mp_ * s.a + dampA_ * (Mp_ * s.v) + dampB_ * (Kp_ * s.v);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i)
+      s.reaction[i] += Kq_[ops.prescribedDofs[i]] + fI_[ops.prescribedDofs[i]];
+  }
+
+  // H = (1 + dt/2 a) M + dt/2 b K, split into free and prescribed parts; H_ff factorised
+  void factorise(const Operators& ops, bool first) {
+    const SpMat H = (1.0 + 0.5 * dt_ * dampA_) * ops.M + (0.5 * dt_ * dampB_) * ops.K;
     std::vector<Eigen::Triplet<double>> tff, tfp;
     std::vector<int> presIndex(H.rows(), -1);
-    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) presIndex[sim.prescribedDofs[i]] = static_cast<int>(i);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) presIndex[ops.prescribedDofs[i]] = static_cast<int>(i);
     for (int c = 0; c < H.outerSize(); ++c)
       for (SpMat::InnerIterator it(H, c); it; ++it) {
-        const int fr = sim.dofToFree[it.row()];
+        const int fr = ops.dofToFree[it.row()];
         if (fr < 0) continue;
-        const int fc = sim.dofToFree[c];
+        const int fc = ops.dofToFree[c];
         if (fc >= 0) tff.emplace_back(fr, fc, it.value());
         else tfp.emplace_back(fr, presIndex[c], it.value());
       }
-    const Eigen::Index nf = static_cast<Eigen::Index>(sim.freeDofs.size());
+    const Eigen::Index nf = static_cast<Eigen::Index>(ops.freeDofs.size());
     SpMat Hff(nf, nf);
     Hff.setFromTriplets(tff.begin(), tff.end());
-    Hfp_.resize(nf, static_cast<Eigen::Index>(sim.prescribedDofs.size()));
+    Hfp_.resize(nf, static_cast<Eigen::Index>(ops.prescribedDofs.size()));
     Hfp_.setFromTriplets(tfp.begin(), tfp.end());
     bool ok;
     if (useUmfpack_) {
@@ -143,19 +189,20 @@ class PaperIntegrator : public Integrator {
       chol_.factorize(Hff);
       ok = chol_.info() == Eigen::Success;
     }
-    if (!ok) throw IntegratorError("factorisation of H = M + dt/2 C failed (matrix not positive definite?)");
-    Mp_ = selectRows(sim.M, sim.prescribedDofs);
-    Kp_ = selectRows(sim.K, sim.prescribedDofs);
+    if (!ok) throw SolverError("factorisation of H = M + dt/2 C failed (matrix not positive definite?)");
+    Mp_ = selectRows(ops.M, ops.prescribedDofs);
+    Kp_ = selectRows(ops.K, ops.prescribedDofs);
   }
 
   double dt_ = 0;
   bool useUmfpack_ = false;
+  double dampA_ = 0, dampB_ = 0;  // Rayleigh C = a M + b K
   Eigen::CholmodSupernodalLLT<SpMat> chol_;
   Eigen::UmfPackLU<SpMat> lu_;
   SpMat Hfp_, Mp_, Kp_;
-  VecX w_, fI_, Kq_, Kw_, Mw_, r_, rf_, af_;
+  VecX w_, fI_, Kq_, Kw_, Mw_, r_, rf_, af_, aGrip_, vGrip_;
+  std::vector<cohesive::Vec3> forceOnB_;
 };
-
 
 // Rotary-inertia scale for the lumped element (DESIGN section 4): with physical rotary inertia the short
 // beam's rotation modes govern; scaling the rotary inertia up lowers them until the element's highest
@@ -178,22 +225,25 @@ double rotaryScaleForTranslationalLimit(const beam::Section& s, double L) {
 // Largest frequency of the assembled undamped system M^-1 (K + K_iface) with a diagonal mass, by power
 // iteration (prescribed DOFs held). Interfaces enter through their elastic force at a small amplitude (the
 // law is linear below delta0, contact included), never assembled.
-double estimateOmegaMax(Simulation& sim, const VecX& invMass) {
+double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law& law, const Operators& ops,
+                        const VecX& invMass) {
   const int n = static_cast<int>(invMass.size());
   VecX x = VecX::Zero(n), f(n), y(n);
   std::uint64_t seed = 12345;  // fixed start vector: the estimate is deterministic
-  for (int dof : sim.freeDofs) {
+  for (int dof : ops.freeDofs) {
     seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
     x[dof] = static_cast<double>(seed >> 11) / 9007199254740992.0 - 0.5;
   }
   // the case's delta0 (not the law's: unbreakable interfaces have an infinite one)
-  const double amplitude = 1e-3 * sim.params.sigma0() / sim.params.k();
+  const double amplitude = 1e-3 * p.sigma0() / p.k();
+  std::vector<double> lambdaMax(m.numInterfaces(), 0.0);  // undamaged
+  std::vector<cohesive::Vec3> forceOnB;
   double lambda = 0;
   for (int it = 0; it < 300; ++it) {
     x *= amplitude / x.cwiseAbs().maxCoeff();
-    sim.computeForcesForInterfaces(x, f, false);
-    y = invMass.cwiseProduct(sim.K * x + f);
-    for (int dof : sim.prescribedDofs) y[dof] = 0;
+    computeForcesForInterfaces(m, law, ops, x, lambdaMax, false, forceOnB, f);
+    y = invMass.cwiseProduct(ops.K * x + f);
+    for (int dof : ops.prescribedDofs) y[dof] = 0;
     const double next = x.dot(y.cwiseQuotient(invMass)) / x.dot(x.cwiseQuotient(invMass));
     x = y;
     if (it > 20 && std::abs(next - lambda) < 1e-6 * next) { lambda = next; break; }
@@ -221,7 +271,7 @@ struct NodeBlockMatrix {
 };
 
 NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
-  if (K.rows() % 6 != 0) throw IntegratorError("stiffness matrix: size not a multiple of 6");
+  if (K.rows() % 6 != 0) throw SolverError("stiffness matrix: size not a multiple of 6");
   NodeBlockMatrix B;
   B.blockRows = static_cast<int>(K.rows() / 6);
   B.start.assign(1, 0);
@@ -229,15 +279,15 @@ NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
   std::array<double, 36> block;
   for (int R = 0; R < B.blockRows; ++R) {
     const int first = static_cast<int>(K.outerIndexPtr()[6 * R]), count = K.outerIndexPtr()[6 * R + 1] - first;
-    if (count % 6 != 0) throw IntegratorError("stiffness matrix: a row is not made of whole 6 x 6 blocks");
+    if (count % 6 != 0) throw SolverError("stiffness matrix: a row is not made of whole 6 x 6 blocks");
     for (int k = 0; k < count; k += 6) {
       const int c = K.innerIndexPtr()[first + k];
-      if (c % 6 != 0) throw IntegratorError("stiffness matrix: a block does not start on a node");
+      if (c % 6 != 0) throw SolverError("stiffness matrix: a block does not start on a node");
       for (int j = 0; j < 6; ++j)
         for (int i = 0; i < 6; ++i) {
           const int row = 6 * R + i, at = K.outerIndexPtr()[row] + k + j;
           if (K.outerIndexPtr()[row + 1] - K.outerIndexPtr()[row] != count || K.innerIndexPtr()[at] != c + j)
-            throw IntegratorError("stiffness matrix: the rows of a node do not share one block pattern");
+            throw SolverError("stiffness matrix: the rows of a node do not share one block pattern");
           block[6 * j + i] = K.valuePtr()[at];
         }
       const std::string key(reinterpret_cast<const char*>(block.data()), sizeof block);
@@ -281,38 +331,46 @@ void multiplyTwo(const NodeBlockMatrix& K, const VecX& x1, const VecX& x2, VecX&
 //   C = a M + b' K with b' = min(b, c/omega_max), c = damping_cap (default 1: the stiffness part's damping
 //      ratio at omega_max is at most 1/2; an explicit stiffness damping above that would need a far smaller
 //      step, and a lower cap allows a larger one).
-//   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface(q_n) - b' K v_{n-1/2})] / (1 + a dt/2)
-//   q_{n+1}   = q_n + dt v_{n+1/2}
 //   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
 //   2 / omega_max (sqrt(1 + xi^2) - xi), xi = b' omega_max / 2.
+// One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first:
+//   f_iface(q_n), K q_n, K v_{n-1/2}                      (forces for interfaces, for beams; the interfaces'
+//                                                          history is updated here, at q_n)
+//   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface - b' K v_{n-1/2})] / (1 + a dt/2)
+//   v_{n+1/2} of the grips = shape V(t_n + dt/2)          (velocities, boundary condition on them)
+//   R_p = (K q + f_iface + b' K v_{n-1/2} + M (a_p + a v_p))_p at t_n, with the grips' a_p and v_p by central
+//         differences of v_{n-1/2} and v_{n+1/2}; W_ext += dt/2 (P_{n-1} + P_n)   (reactions, grips' work)
+//   W_damp += dt v_{n+1/2} . (a M v_{n+1/2} + b' K v_{n-1/2})   (damping work: the step's displacement
+//                                                          against the damping force, its stiffness part
+//                                                          as applied, at the lagged velocity)
+//   q_{n+1} = q_n + dt v_{n+1/2};  q of the grips = shape U(t_{n+1})   (positions, boundary condition)
 class LumpedIntegrator : public Integrator {
  public:
-  explicit LumpedIntegrator(Simulation& sim) {
-    const Model& m = sim.model;
+  LumpedIntegrator(const CaseParams& p, const Model& m, const Materials& mat, const Operators& ops)
+      : dampA_(mat.dampA) {
     const double L = m.beamLength;
-    rotaryScale_ = rotaryScaleForTranslationalLimit(sim.section, L);
-    Kblocks_ = toNodeBlocks(SpMatRow(sim.K));
-    const double mt = 0.5 * sim.section.rho * sim.section.A * L;
-    const double jr = rotaryScale_ * 0.5 * sim.section.rho * sim.section.Ip * L;
+    rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
+    Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
+    const double mt = 0.5 * mat.section.rho * mat.section.A * L;
+    const double jr = rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * L;
     mass_ = VecX::Zero(m.numDofs());
     auto addElementMass = [&](int a, int b) {
       for (int node : {a, b})
         for (int k = 0; k < 3; ++k) { mass_[6 * node + k] += mt; mass_[6 * node + 3 + k] += jr; }
     };
     for (int e = 0; e < m.numBeams(); ++e) addElementMass(m.beamNodes[e][0], m.beamNodes[e][1]);
-    for (const auto& ab : sim.cutBeamNodes) addElementMass(ab[0], ab[1]);  // cut by the pre-crack: mass stays
+    for (const auto& ab : ops.cutBeamNodes) addElementMass(ab[0], ab[1]);  // cut by the pre-crack: mass stays
     for (int i = 0; i < mass_.size(); ++i)
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();
-    sim.addedRotaryInertia = rotaryScale_ - 1.0;
-    omegaMax_ = estimateOmegaMax(sim, invMass_);
-    bEff_ = std::min(sim.dampB, sim.params.damping_cap / omegaMax_);
-    dt_ = sim.params.dt_factor * 2.0 * M_PI / omegaMax_;
-    const double xi = 0.5 * bEff_ * omegaMax_ + 0.5 * sim.dampA / omegaMax_;
+    omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
+    bEff_ = std::min(mat.dampB, p.damping_cap / omegaMax_);
+    dt_ = p.dt_factor * 2.0 * M_PI / omegaMax_;
+    const double xi = 0.5 * bEff_ * omegaMax_ + 0.5 * mat.dampA / omegaMax_;
     const double limit = 2.0 / omegaMax_ * (std::sqrt(1.0 + xi * xi) - xi);
     if (dt_ > 0.95 * limit) {
       std::ostringstream msg;
-      msg << "time step dt = " << dt_ << " (dt_factor " << sim.params.dt_factor
+      msg << "time step dt = " << dt_ << " (dt_factor " << p.dt_factor
           << " x smallest period 2 pi/omega_max of the lumped system) is above the stable limit 0.95 x "
           << limit << " (omega_max = " << omegaMax_ << ", damping ratio there " << xi
           << "): use dt_factor <= " << 0.95 * limit * omegaMax_ / (2 * M_PI);
@@ -323,6 +381,8 @@ class LumpedIntegrator : public Integrator {
   std::string name() const override { return "lumped"; }
   double timeStep() const override { return dt_; }
   bool usesConsistentMass() const override { return false; }
+  bool usesHalfStepVelocity() const override { return true; }
+  double addedRotaryInertia() const override { return rotaryScale_ - 1.0; }
   std::string describe() const override {
     std::ostringstream o;
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
@@ -331,72 +391,80 @@ class LumpedIntegrator : public Integrator {
     return o.str();
   }
 
-  void advance(Simulation& sim) override {
-    State& s = sim.state;  // s.v holds the half-step velocity v_{n-1/2} (checkpointable as it is); s.a is unused
-    const double dt = dt_, a = sim.dampA;
-    const std::vector<int>& pres = sim.prescribedDofs;
-    // forces at q_n (interfaces update their history here), stiffness damping at v_{n-1/2}
+  void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     fI_.resize(s.q.size());
-    sim.computeForcesForInterfaces(s.q, fI_, true);
-    multiplyTwo(Kblocks_, s.q, s.v, Kq_, Kv_);
-    vPresOld_.resize(pres.size());
-    for (std::size_t i = 0; i < pres.size(); ++i) vPresOld_[i] = s.v[pres[i]];
-    s.v = ((1.0 - 0.5 * a * dt) * s.v - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) / (1.0 + 0.5 * a * dt);
-    // prescribed DOFs follow the loading, at the half step
-    const double Vh = sim.loading.velocity(s.time + 0.5 * dt);
-    for (std::size_t i = 0; i < pres.size(); ++i) s.v[pres[i]] = sim.prescribedShape[i] * Vh;
-    // reactions at t_n: R_p = (K q + f_iface + M a + C v)_p, with a and v by central differences
-    double power = 0;
-    for (std::size_t i = 0; i < pres.size(); ++i) {
-      const int dof = pres[i];
-      const double acc = (s.v[dof] - vPresOld_[i]) / dt, vel = 0.5 * (s.v[dof] + vPresOld_[i]);
-      sim.reaction[i] = Kq_[dof] + fI_[dof] + bEff_ * Kv_[dof] + mass_[dof] * (acc + a * vel);
-      power += sim.reaction[i] * vel;
-    }
-    if (s.step > 0) s.externalWork += 0.5 * dt * (s.lastExternalPower + power);
-    s.lastExternalPower = power;
-    // damping work over the step: the step's displacement dt v_{n+1/2} against the damping force, its
-    // stiffness part as applied (at the lagged velocity)
-    s.dampingWork += dt * (a * s.v.dot(mass_.cwiseProduct(s.v)) + bEff_ * s.v.dot(Kv_));
-    s.q += dt * s.v;
-    s.time += dt;
-    ++s.step;
-    sim.applyBoundaryConditions(s.time);  // q of the prescribed DOFs at t_{n+1} (it also sets their v to t_{n+1}):
-    for (std::size_t i = 0; i < pres.size(); ++i) s.v[pres[i]] = sim.prescribedShape[i] * Vh;  // keep v_{n+1/2}
+    s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
+    multiplyTwo(Kblocks_, s.q, s.vHalf, Kq_, Kv_);  // forces for beams: K q_n, K v_{n-1/2}
+    gatherGrips(ops, s.vHalf, vGripBefore_);
+    advanceVelocities(s);
+    prescribeVelocities(ops, mat.loading.velocity(s.time + 0.5 * dt_), s.vHalf);
+    computeReactions(ops, s);
+    addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
+    addDampingWork(s);
+    advancePositions(s);
+    advanceClock(s, dt_);
+    prescribeDisplacements(ops, mat.loading, s.time, s);
   }
 
-  void initialise(Simulation& sim) override {
-    State& s = sim.state;
-    sim.applyBoundaryConditions(s.time);
+  void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    applyBoundaryConditions(ops, mat.loading, s.time, s);
     fI_.resize(s.q.size());
-    sim.computeForcesForInterfaces(s.q, fI_, false);
-    const VecX acc = -invMass_.cwiseProduct(fI_ + sim.K * s.q + bEff_ * (sim.K * s.v)) - sim.dampA * s.v;
-    for (int dof : sim.freeDofs) s.v[dof] -= 0.5 * dt_ * acc[dof];
-    const double Vh = sim.loading.velocity(s.time - 0.5 * dt_);
-    for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) s.v[sim.prescribedDofs[i]] = sim.prescribedShape[i] * Vh;
+    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
+    const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
+    s.vHalf = s.v;
+    for (int dof : ops.freeDofs) s.vHalf[dof] -= 0.5 * dt_ * acc[dof];
+    prescribeVelocities(ops, mat.loading.velocity(s.time - 0.5 * dt_), s.vHalf);
   }
 
-  void onBeamsDeleted(Simulation& sim) override {  // lumped mass stays; K is already updated in sim
-    Kblocks_ = toNodeBlocks(SpMatRow(sim.K));
+  void updateOperators(const Operators& ops) override {  // the lumped mass stays; only K changed
+    Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
   }
 
-  double kineticEnergy(const Simulation& sim) const override {
-    return 0.5 * sim.state.v.dot(mass_.cwiseProduct(sim.state.v));
+  double kineticEnergy(const Operators&, const State& s) const override {
+    return 0.5 * s.vHalf.dot(mass_.cwiseProduct(s.vHalf));
   }
 
  private:
-  double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0;
-  VecX mass_, invMass_, vPresOld_, fI_, Kq_, Kv_;
-  NodeBlockMatrix Kblocks_;  // sim.K in node blocks, for the fused product
+  // v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 (K q_n + f_iface + b' K v_{n-1/2})] / (1 + a dt/2)
+  void advanceVelocities(State& s) const {
+    const double a = dampA_, dt = dt_;
+    s.vHalf = ((1.0 - 0.5 * a * dt) * s.vHalf - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) /
+              (1.0 + 0.5 * a * dt);
+  }
+
+  // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
+  // a_p = (v_{n+1/2} - v_{n-1/2}) / dt and v_p = (v_{n+1/2} + v_{n-1/2}) / 2 (kept in vGrip_)
+  void computeReactions(const Operators& ops, State& s) {
+    vGrip_.resize(vGripBefore_.size());
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
+      const int dof = ops.prescribedDofs[i];
+      const double acc = (s.vHalf[dof] - vGripBefore_[i]) / dt_, vel = 0.5 * (s.vHalf[dof] + vGripBefore_[i]);
+      s.reaction[i] = Kq_[dof] + fI_[dof] + bEff_ * Kv_[dof] + mass_[dof] * (acc + dampA_ * vel);
+      vGrip_[i] = vel;
+    }
+  }
+
+  // W_damp += dt (a v_{n+1/2} . M v_{n+1/2} + b' v_{n+1/2} . K v_{n-1/2})
+  void addDampingWork(State& s) const {
+    s.dampingWork += dt_ * (dampA_ * s.vHalf.dot(mass_.cwiseProduct(s.vHalf)) + bEff_ * s.vHalf.dot(Kv_));
+  }
+
+  // q_{n+1} = q_n + dt v_{n+1/2}
+  void advancePositions(State& s) const { s.q += dt_ * s.vHalf; }
+
+  double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
+  VecX mass_, invMass_, fI_, Kq_, Kv_, vGripBefore_, vGrip_;
+  NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
+  std::vector<cohesive::Vec3> forceOnB_;
 };
 
 }  // namespace
 
-std::unique_ptr<Integrator> makeIntegrator(Simulation& sim) {
-  const std::string& name = sim.params.integrator;
-  if (name == "paper") return std::make_unique<PaperIntegrator>(sim);
-  if (name == "lumped") return std::make_unique<LumpedIntegrator>(sim);
-  throw IntegratorError("integrator '" + name + "' is not available in this build (available: paper, lumped)");
+std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, const Materials& mat,
+                                           const Operators& ops) {
+  if (p.integrator == "paper") return std::make_unique<PaperIntegrator>(p, mat, ops);
+  if (p.integrator == "lumped") return std::make_unique<LumpedIntegrator>(p, m, mat, ops);
+  throw IntegratorError("integrator '" + p.integrator + "' is not available in this build (available: paper, lumped)");
 }
 
 }  // namespace enamel

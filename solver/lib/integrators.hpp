@@ -1,20 +1,58 @@
 #pragma once
-// Time integrators. `paper` is the reference (paper eq. 12-18); fast schemes sit beside it behind the
-// same small interface (simulation.hpp: Integrator) and are chosen by the case key `integrator`.
+// Time integrators. `paper` is the reference (paper eq. 12-18); fast schemes sit beside it behind the same
+// small interface and are chosen by the case key `integrator`. A scheme keeps its own data (dt, its mass or
+// factorisation, scratch); it is given the set-up data by const reference and the State by reference.
 #include <memory>
 #include <stdexcept>
 #include <string>
 
-#include "simulation.hpp"
+#include "case_params.hpp"
+#include "state.hpp"
 
 namespace enamel {
 
-/// A time step the integrator cannot run stably, or a factorisation that failed: the message says which.
+/// A case the scheme cannot run (a time step above the stable limit, a node without mass, an unknown
+/// scheme): bad input, the message says which.
 struct IntegratorError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The integrator named by sim.params.integrator. Throws IntegratorError when dt is above the stable limit.
-std::unique_ptr<Integrator> makeIntegrator(Simulation& sim);
+/// A numerical failure while setting up or running (a factorisation that failed, an operator without the
+/// structure the scheme relies on): the run failed, the input was not refused.
+struct SolverError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A time integrator: advances the State by one step.
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual std::string name() const = 0;
+  virtual double timeStep() const = 0;
+  /// Advance s from t_n to t_n + dt, as the scheme's doc comment lists the step (integrators.cpp): forces,
+  /// velocities, positions, boundary conditions, reactions and the work of the grips, damping work.
+  virtual void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) = 0;
+  /// Make the scheme's own state consistent with a given q, v at s.time (a run from rest needs nothing):
+  /// `paper` solves for the accelerations, H a = -f_iface(q) - K q - C v; `lumped` sets the half-step
+  /// velocity vHalf = v_{-1/2} = v - dt/2 M^-1 (-f_iface(q) - K q - C v). Used for initial-value tests.
+  virtual void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) = 0;
+  /// K and M changed (rod elements deleted): update what the scheme derived from them.
+  virtual void updateOperators(const Operators& ops) = 0;
+  /// Kinetic energy 1/2 v^T M v with this scheme's mass matrix and velocity.
+  virtual double kineticEnergy(const Operators& ops, const State& s) const = 0;
+  /// Whether the scheme's mass is the consistent one (ops.M); false for lumped-mass schemes.
+  virtual bool usesConsistentMass() const { return true; }
+  /// Whether the scheme's velocity is the half-step one (State::vHalf) rather than v_n (State::v).
+  virtual bool usesHalfStepVelocity() const { return false; }
+  /// Rotary inertia the scheme added, as a fraction of the physical one (reported in the output).
+  virtual double addedRotaryInertia() const { return 0; }
+  /// One line on the scheme's own choices (mass scaling, damping), for the output's provenance.
+  virtual std::string describe() const { return name(); }
+};
+
+/// The integrator named by p.integrator, set up for these operators. Throws IntegratorError when dt is above
+/// the stable limit, SolverError when a factorisation fails.
+std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, const Materials& mat,
+                                           const Operators& ops);
 
 }  // namespace enamel

@@ -9,7 +9,9 @@
 #include <functional>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 
+#include "kernels.hpp"
 #include "strength.hpp"
 #include "version.hpp"
 
@@ -28,16 +30,47 @@ Frame captureFrame(const Simulation& sim, double targetDa) {
   f.ifaceState.resize(ni);
   for (int i = 0; i < ni; ++i) {
     const double lm = sim.state.lambdaMax[i];
-    f.ifaceDamage[i] = static_cast<float>(cohesive::damage(sim.law, lm));
-    f.ifaceState[i] = cohesive::isFailed(sim.law, lm) ? 2 : cohesive::isInelastic(sim.law, lm) ? 1 : 0;
+    f.ifaceDamage[i] = static_cast<float>(cohesive::damage(sim.materials.law, lm));
+    f.ifaceState[i] = cohesive::isFailed(sim.materials.law, lm) ? 2 : cohesive::isInelastic(sim.materials.law, lm) ? 1 : 0;
   }
   f.beamBroken = sim.state.beamBroken;
+  f.beamStress.resize(sim.model.numBeams());
+  for (int e = 0; e < sim.model.numBeams(); ++e)
+    f.beamStress[e] = sim.state.beamBroken[e] ? NAN
+        : static_cast<float>(computeStressOfBeam(sim.model, sim.materials, sim.state.q, e) / sim.params.sigma0());
   return f;
 }
 
 std::string resultFileFor(const std::string& dir, const std::string& status) {
   const char* name = status == "completed" ? "result.h5" : status == "failed" ? "result.failed.h5" : "result.partial.h5";
   return dir + "/" + name;
+}
+
+const std::vector<HistoryColumn>& historyColumns() {
+  using M = Measurement;
+  static const char* eu = "E_r d^3 (per z-period B = sqrt(3) d)";
+  static const std::vector<HistoryColumn> columns = {
+      {"step", &M::step, "-"},
+      {"time", &M::time, "d/c_r"},
+      {"applied_displacement", &M::appliedDisplacement, "d",
+       "u_y at the cracked edge of the top row (bottom row: minus this)"},
+      {"load", &M::load, "E_r d^2", "generalised force conjugate to applied_displacement"},
+      {"J_over_Gamma", &M::J, "Gamma_i", "", true},
+      {"da_over_d", &M::crackAdvance, "d"},
+      {"kinetic_energy", &M::kinetic, eu},
+      {"strain_energy_beams", &M::strainBeams, eu},
+      {"strain_energy_interfaces", &M::strainInterfaces, eu},
+      {"damping_dissipation", &M::damping, eu},
+      {"fracture_dissipation_interfaces", &M::fracture, eu},
+      {"fracture_energy_rods", &M::rodFracture, eu},
+      {"external_work", &M::external, eu},
+      {"energy_balance_error", &M::balanceError, "-",
+       "(external work - stored - kinetic - dissipated) / external work"},
+      {"broken_rod_elements", &M::brokenBeams, "count"},
+      {"failed_interfaces", &M::failedInterfaces, "count"},
+      {"inelastic_interfaces", &M::inelasticInterfaces, "count"},
+  };
+  return columns;
 }
 
 RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& R) {
@@ -146,12 +179,17 @@ std::string utcNow() {
   return buf;
 }
 
-template <class F>
-std::vector<double> column(const std::vector<Measurement>& h, F f) {
-  std::vector<double> out;
-  out.reserve(h.size());
-  for (const auto& m : h) out.push_back(f(m));
-  return out;
+// One /history dataset: the column's field over all rows, in the field's own type.
+void historyDataset(hid_t group, const HistoryColumn& c, const std::vector<Measurement>& h, double Gamma) {
+  std::visit([&](auto field) {
+    using T = std::remove_reference_t<decltype(Measurement{}.*field)>;
+    std::vector<T> values;
+    values.reserve(h.size());
+    for (const Measurement& r : h) values.push_back(r.*field);
+    if (c.perGamma)
+      for (T& x : values) x /= Gamma;
+    dataset(group, c.name, values, 1, c.unit, c.description);
+  }, c.field);
 }
 
 }  // namespace
@@ -176,7 +214,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "git_hash", kGitHash);
       attr(g.id, "integrator", sim.integrator->name());
       attr(g.id, "integrator_details", sim.integrator->describe());
-      attr(g.id, "added_rotary_inertia", sim.addedRotaryInertia);
+      attr(g.id, "added_rotary_inertia", sim.integrator->addedRotaryInertia());
       attr(g.id, "linear_solver", p.linear_solver);
       attr(g.id, "deletion_rule", p.deletion_rule);
       attr(g.id, "seed", static_cast<long>(p.seed));
@@ -196,12 +234,12 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "
                           "(time in d/c_r, c_r = sqrt(E_r/rho_r))");
       attr(g.id, "dt", sim.integrator->timeStep());
-      attr(g.id, "E_transverse_over_Er", sim.E_transverse);
-      attr(g.id, "c_d_over_cr", sim.c_d);
-      attr(g.id, "rayleigh_a", sim.dampA);
-      attr(g.id, "rayleigh_b", sim.dampB);
-      attr(g.id, "omega_max_element", sim.omegaMaxElement);
-      attr(g.id, "v_app", sim.loading.vApp);
+      attr(g.id, "E_transverse_over_Er", sim.materials.E_transverse);
+      attr(g.id, "c_d_over_cr", sim.materials.c_d);
+      attr(g.id, "rayleigh_a", sim.materials.dampA);
+      attr(g.id, "rayleigh_b", sim.materials.dampB);
+      attr(g.id, "omega_max_element", sim.materials.omegaMaxElement);
+      attr(g.id, "v_app", sim.materials.loading.vApp);
       attr(g.id, "Gamma_i", Gamma);
       attr(g.id, "sigma0", p.sigma0());
       attr(g.id, "k", p.k());
@@ -227,33 +265,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
     // --- /history ---
     {
       Handle g(H5Gcreate2(file.id, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/history");
-      const auto& h = rec.history;
-      std::vector<long> steps;
-      for (const auto& r : h) steps.push_back(r.step);
-      dataset(g.id, "step", steps, 1, "-");
-      dataset(g.id, "time", column(h, [](auto& r) { return r.time; }), 1, "d/c_r");
-      dataset(g.id, "applied_displacement", column(h, [](auto& r) { return r.appliedDisplacement; }), 1, "d",
-              "u_y at the cracked edge of the top row (bottom row: minus this)");
-      dataset(g.id, "load", column(h, [](auto& r) { return r.load; }), 1, "E_r d^2",
-              "generalised force conjugate to applied_displacement");
-      dataset(g.id, "J_over_Gamma", column(h, [&](auto& r) { return r.J / Gamma; }), 1, "Gamma_i");
-      dataset(g.id, "da_over_d", column(h, [](auto& r) { return r.crackAdvance; }), 1, "d");
-      const char* eu = "E_r d^3 (per z-period B = sqrt(3) d)";
-      dataset(g.id, "kinetic_energy", column(h, [](auto& r) { return r.kinetic; }), 1, eu);
-      dataset(g.id, "strain_energy_beams", column(h, [](auto& r) { return r.strainBeams; }), 1, eu);
-      dataset(g.id, "strain_energy_interfaces", column(h, [](auto& r) { return r.strainInterfaces; }), 1, eu);
-      dataset(g.id, "damping_dissipation", column(h, [](auto& r) { return r.damping; }), 1, eu);
-      dataset(g.id, "fracture_dissipation_interfaces", column(h, [](auto& r) { return r.fracture; }), 1, eu);
-      dataset(g.id, "fracture_energy_rods", column(h, [](auto& r) { return r.rodFracture; }), 1, eu);
-      dataset(g.id, "external_work", column(h, [](auto& r) { return r.external; }), 1, eu);
-      dataset(g.id, "energy_balance_error", column(h, [](auto& r) { return r.balanceError; }), 1, "-",
-              "(external work - stored - kinetic - dissipated) / external work");
-      std::vector<int> broken, failed, inelastic;
-      for (const auto& r : h) { broken.push_back(r.brokenBeams); failed.push_back(r.failedInterfaces);
-                                inelastic.push_back(r.inelasticInterfaces); }
-      dataset(g.id, "broken_rod_elements", broken, 1, "count");
-      dataset(g.id, "failed_interfaces", failed, 1, "count");
-      dataset(g.id, "inelastic_interfaces", inelastic, 1, "count");
+      for (const HistoryColumn& c : historyColumns()) historyDataset(g.id, c, rec.history, Gamma);
     }
     // --- /geometry ---
     {
@@ -270,7 +282,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       for (const auto& b : m.ifaceNodes) in.insert(in.end(), {b[0], b[1]});
       dataset(g.id, "beam_nodes", bn, 2, "-");
       dataset(g.id, "beam_strength_over_sigma0", [&] {
-        std::vector<double> s(sim.beamStrength);
+        std::vector<double> s(sim.materials.beamStrength);
         for (double& v : s) v /= p.sigma0();
         return s; }(), 1, "sigma0");
       dataset(g.id, "iface_nodes", in, 2, "-", "A, B; B through the z-wrap when iface_zshift = 1");
@@ -315,6 +327,9 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
         dataset(fg.id, "iface_damage", f.ifaceDamage, 1, "-", "1 - secant stiffness / k");
         dataset(fg.id, "iface_state", f.ifaceState, 1, "-", "0 elastic, 1 inelastic (process zone), 2 failed");
         dataset(fg.id, "beam_broken", f.beamBroken, 1, "-", "1 = rod element deleted");
+        dataset(fg.id, "beam_stress", f.beamStress, 1, "sigma0",
+                "largest tensile stress of the rod element / sigma0 (the solver's deletion check, "
+                "kernels.cpp computeStressOfBeam); NaN for deleted elements");
       }
     }
     if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("HDF5: cannot flush '" + tmp + "'");

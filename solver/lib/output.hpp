@@ -4,6 +4,7 @@
 // `path`, so a reader (or a run killed half-way) never sees a half-written file.
 #include <cstdint>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "simulation.hpp"
@@ -20,6 +21,7 @@ struct Frame {
   std::vector<float> ifaceDamage;           // 1 - S/k
   std::vector<std::uint8_t> ifaceState;     // 0 elastic, 1 inelastic (process zone), 2 failed
   std::vector<std::uint8_t> beamBroken;
+  std::vector<float> beamStress;            // per rod element: kernels.hpp computeStressOfBeam / sigma0; NaN deleted
 };
 
 struct RunRecord {
@@ -36,6 +38,18 @@ struct RunRecord {
 };
 
 Frame captureFrame(const Simulation& sim, double targetDa);
+
+/// One column of /history: its dataset name, unit, description and the Measurement field it holds (a
+/// Measurement field in units of Gamma_i is divided by it: `perGamma`).
+struct HistoryColumn {
+  const char* name;
+  std::variant<long Measurement::*, int Measurement::*, double Measurement::*> field;
+  const char* unit;
+  const char* description = "";
+  bool perGamma = false;
+};
+/// Every column of /history, in the order they are written.
+const std::vector<HistoryColumn>& historyColumns();
 
 /// Summary numbers of an R-curve (DESIGN section 5), normalised by Gamma_i.
 struct RcurveSummary {

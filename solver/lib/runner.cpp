@@ -6,9 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <cstdlib>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
+
+#include "exit_codes.hpp"
 
 namespace enamel {
 
@@ -56,158 +58,230 @@ double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& no
 
 void requestStop(int signal) { gStopSignal = signal; }
 
-RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
-  using clock = std::chrono::steady_clock;
-  const auto start = clock::now();
-  double wallBefore = 0;  // wall time of the run before a restart
-  auto wall = [&] { return wallBefore + std::chrono::duration<double>(clock::now() - start).count(); };
-  const CaseParams& p = sim.params;
-  const double dt = sim.integrator->timeStep();
-  const double Gamma = p.Gamma();
-  const long historyEvery = p.history_every > 0
-      ? p.history_every : std::max(1L, std::lround(0.05 * sim.model.h_s / sim.c_d / dt));
-  const bool tty = isatty(STDERR_FILENO);
+int exitCodeOf(const std::exception& e) {
+  if (const auto* c = dynamic_cast<const CaseError*>(&e)) return c->exitCode;
+  if (dynamic_cast<const CheckpointError*>(&e)) return exit_code::checkpoint_invalid;
+  if (dynamic_cast<const IntegratorError*>(&e) || dynamic_cast<const std::invalid_argument*>(&e))
+    return exit_code::out_of_range;
+  return exit_code::run_failed;
+}
 
-  RunRecord rec;
-  std::size_t nextFrame = 0;
-  std::vector<double> frameTargets = p.frames_da_over_d;
-  std::sort(frameTargets.begin(), frameTargets.end());
-  double lastWrite = 0, lastProgress = 0, lastDa = 0;
-  bool& warnedBalance = rec.warnedBalance;
-  bool& warnedKinetic = rec.warnedKinetic;
-  double lastCheckpoint = 0;
-  auto checkpoint = [&] {
-    if (opt.checkpointPath.empty()) return;
-    rec.wallSeconds = wall();
-    rec.steps = sim.state.step;
-    writeCheckpoint(opt.checkpointPath, sim, rec);
-    lastCheckpoint = rec.wallSeconds;
-  };
-  const double minWork = kBalanceMinWork * Gamma * sim.model.B;
-  const std::string partialPath = resultFileFor(opt.outDir, "running");
-  auto save = [&] {
-    rec.wallSeconds = wall();
-    rec.steps = sim.state.step;
-    writeResultFile(resultFileFor(opt.outDir, rec.status), sim, rec);
-    lastWrite = rec.wallSeconds;
-  };
-  auto fail = [&](const std::string& why) {
-    rec.status = "failed";
-    rec.stopReason = why;
-  };
+namespace {
 
-  // Fault injection for the tests of the failure path: ENAMEL_INJECT_NAN_AT_STEP=N puts a NaN into one free
-  // displacement after step N, as a diverging run would (tests/python/test_cli.py).
-  const char* injectEnv = std::getenv("ENAMEL_INJECT_NAN_AT_STEP");
-  const long injectAt = injectEnv ? std::atol(injectEnv) : -1;
-  if (opt.restart) {
-    readCheckpoint(opt.checkpointPath, sim, rec);
-    rec.status = "running";
-    rec.stopReason.clear();
-    wallBefore = lastCheckpoint = rec.wallSeconds;
-    lastDa = rec.rcurveDa.empty() ? 0.0 : rec.rcurveDa.back();
-    nextFrame = rec.frames.size();  // frames are taken in the order of their sorted targets
-    std::fprintf(stderr, "enamel-dem: resuming from checkpoint at step %ld (U/d %.4g, da/d %.3g, %s of wall time so far)\n",
-                 sim.state.step, sim.state.appliedDisplacement, sim.state.crackAdvance,
-                 formatDuration(rec.wallSeconds).c_str());
-  } else {
-    rec.history.push_back(sim.measure());
+// One run's bookkeeping around the time steps: its record, clocks, next frame, and the named calls of the
+// loop in runSimulation. Each call is defined once here.
+class RunLoop {
+ public:
+  RunLoop(Simulation& sim, const RunOptions& opt)
+      : sim_(sim), opt_(opt), p_(sim.params), start_(clock::now()), tty_(isatty(STDERR_FILENO)),
+        frameTargets_(p_.frames_da_over_d),
+        stopTargets_{p_.stop_da_over_d, p_.stop_u_over_d, double(p_.max_steps)},
+        minWork_(kBalanceMinWork * p_.Gamma() * sim.model.B), partialPath_(resultFileFor(opt.outDir, "running")) {
+    const double dt = sim.integrator->timeStep();
+    historyEvery_ = p_.history_every > 0
+        ? p_.history_every : std::max(1L, std::lround(0.05 * sim.model.h_s / sim.materials.c_d / dt));
+    std::sort(frameTargets_.begin(), frameTargets_.end());
   }
-  save();
-  // Progress rates are measured over this piece of the run, and the crack's from where it started.
-  auto sample = [&] {
-    return ProgressSample{wall(), double(sim.state.step), sim.state.crackAdvance, sim.state.appliedDisplacement};
-  };
-  const ProgressSample pieceStart = sample();
-  ProgressSample etaSince = pieceStart;
-  const StopTargets stopTargets{p.stop_da_over_d, p.stop_u_over_d, double(p.max_steps)};
+
+  /// From rest (the first history row) or from the checkpoint; the result file written once at the start.
+  void start() {
+    if (opt_.restart) {
+      readCheckpoint(opt_.checkpointPath, sim_, rec_);
+      rec_.status = "running";
+      rec_.stopReason.clear();
+      wallBefore_ = lastCheckpoint_ = rec_.wallSeconds;
+      lastDa_ = rec_.rcurveDa.empty() ? 0.0 : rec_.rcurveDa.back();
+      nextFrame_ = rec_.frames.size();  // frames are taken in the order of their sorted targets
+      std::fprintf(stderr, "enamel-dem: resuming from checkpoint at step %ld (U/d %.4g, da/d %.3g, %s of wall time so far)\n",
+                   sim_.state.step, sim_.state.appliedDisplacement, sim_.state.crackAdvance,
+                   formatDuration(rec_.wallSeconds).c_str());
+    } else {
+      rec_.history.push_back(sim_.measure());
+    }
+    save();
+    // Progress rates are measured over this piece of the run, and the crack's from where it started.
+    pieceStart_ = etaSince_ = sample();
+  }
+
+  /// Fault injection for the tests of the failure path (RunOptions::injectNanAtStep): a NaN in one free
+  /// displacement after that step, as a diverging run would produce.
+  void injectFault() {
+    if (sim_.state.step == opt_.injectNanAtStep) sim_.state.q[sim_.ops.freeDofs[sim_.ops.freeDofs.size() / 2]] = NAN;
+  }
+
+  /// An R-curve point (Delta a, J) each time the crack advanced, and the frames whose targets it passed.
+  void recordRcurvePoint() {
+    const State& s = sim_.state;
+    if (!(s.crackAdvance > lastDa_)) return;
+    if (lastDa_ == 0) {  // the crack starts: its rate is measured from here, its first advance included
+      etaSince_ = sample();
+      etaSince_.crackAdvance = 0;
+    }
+    lastDa_ = s.crackAdvance;
+    rec_.rcurveDa.push_back(s.crackAdvance);
+    rec_.rcurveJ.push_back(sim_.computeJ());
+    while (nextFrame_ < frameTargets_.size() && s.crackAdvance >= frameTargets_[nextFrame_])
+      rec_.frames.push_back(captureFrame(sim_, frameTargets_[nextFrame_++]));
+  }
+
+  bool historyDue() const { return sim_.state.step % historyEvery_ == 0; }
+
+  Measurement recordHistory() {
+    rec_.history.push_back(sim_.measure());
+    return rec_.history.back();
+  }
+
+  /// The quasi-static and stability checks (DESIGN section 4) on a history row: false when the run failed
+  /// (a non-finite state or an energy balance beyond kBalanceFail); warnings are recorded once each.
+  bool checkBalance(const Measurement& r) {
+    const State& s = sim_.state;
+    for (double x : {r.J, r.kinetic, r.strainBeams, r.strainInterfaces, r.external})
+      if (!std::isfinite(x))
+        return fail(fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
+                        "the time step or the loading is unstable", s.step, s.time, r.J, r.kinetic, r.external));
+    if (r.external > minWork_ && std::abs(r.balanceError) > kBalanceFail)
+      return fail(fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g): "
+                      "energy is created or lost; reduce dt_factor or the loading rate",
+                      r.balanceError, s.step, kBalanceFail, r.external));
+    if (!rec_.warnedBalance && r.external > minWork_ && std::abs(r.balanceError) > kBalanceWarn) {
+      rec_.warnedBalance = true;
+      rec_.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
+                                  kBalanceWarn));
+    }
+    const double strain = r.strainBeams + r.strainInterfaces;
+    // Quasi-static check while the crack grows (before it, the ratio only says how far the load has come).
+    const double kineticRatio = s.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
+    rec_.maxKineticRatio = std::max(rec_.maxKineticRatio, kineticRatio);
+    if (!rec_.warnedKinetic && kineticRatio > kKineticWarn) {
+      rec_.warnedKinetic = true;
+      rec_.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
+                                  kineticRatio, s.step, kKineticWarn));
+    }
+    return true;
+  }
+
+  /// A progress line on stderr every 2 s: step, load, crack, R, this piece's steps/s and the time left.
+  void reportProgress(const Measurement& r) {
+    const double w = wall();
+    if (!opt_.progress || !(w - lastProgress_ > 2.0)) return;
+    lastProgress_ = w;
+    const State& s = sim_.state;
+    const ProgressSample now = sample();
+    const double eta = estimateSecondsLeft(etaSince_, now, stopTargets_);
+    const double rate = now.wall > pieceStart_.wall ? (now.step - pieceStart_.step) / (now.wall - pieceStart_.wall) : 0;
+    std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.1f steps/s  ETA %s%s",
+                 tty_ ? "\r" : "", s.step, s.time, now.displacement, s.crackAdvance, r.J / p_.Gamma(),
+                 s.brokenBeams(), rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?", tty_ ? "   " : "\n");
+  }
+
+  /// Rewrite the (partial) result file every writeIntervalSeconds.
+  void saveIfDue() {
+    if (wall() - lastWrite_ > opt_.writeIntervalSeconds) save();
+  }
+
+  /// The first stop criterion met after this step (rec.stopReason and status set), or false.
+  bool findStopReason() {
+    const State& s = sim_.state;
+    const Model& m = sim_.model;
+    const double U = s.appliedDisplacement;
+    const double maxX = m.a0 + s.crackAdvance;
+    if (s.crackAdvance >= p_.stop_da_over_d)
+      rec_.stopReason = fmt("crack advance %.3g d reached stop_da_over_d = %g", s.crackAdvance, p_.stop_da_over_d);
+    else if (maxX >= m.w_s - 2 * m.h_e)
+      rec_.stopReason = fmt("crack reached the far edge (x = %.3g d of w_s = %g d)", maxX, m.w_s);
+    else if (U >= p_.stop_u_over_d)
+      rec_.stopReason = fmt("applied displacement %.4g d reached stop_u_over_d = %g", U, p_.stop_u_over_d);
+    else if (p_.max_steps > 0 && s.step >= p_.max_steps)
+      rec_.stopReason = fmt("step %.0f reached max_steps = %.0f", s.step, double(p_.max_steps));
+    else if (gStopSignal)
+      rec_.stopReason = fmt("interrupted by signal %.0f", gStopSignal);
+    if (rec_.stopReason.empty()) return false;
+    rec_.status = gStopSignal ? "interrupted" : "completed";
+    if (gStopSignal) checkpoint();  // the state after this step: a restart continues from here
+    return true;
+  }
+
+  /// A checkpoint every checkpointIntervalSeconds of wall clock.
+  void checkpointIfDue() {
+    if (opt_.checkpointIntervalSeconds > 0 && wall() - lastCheckpoint_ > opt_.checkpointIntervalSeconds) checkpoint();
+  }
+
+  /// The last history row and frame, the result file under the name of its status (the partial one removed),
+  /// and the checkpoint removed when the run completed.
+  RunRecord finish() {
+    if (opt_.progress && tty_) std::fprintf(stderr, "\n");
+    if (rec_.status != "failed" || rec_.history.empty() || rec_.history.back().step != sim_.state.step)
+      rec_.history.push_back(sim_.measure());
+    rec_.frames.push_back(captureFrame(sim_, -1.0));
+    save();
+    if (resultFileFor(opt_.outDir, rec_.status) != partialPath_) std::remove(partialPath_.c_str());
+    if (rec_.status == "completed" && !opt_.checkpointPath.empty()) std::remove(opt_.checkpointPath.c_str());
+    return rec_;
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+
+  double wall() const { return wallBefore_ + std::chrono::duration<double>(clock::now() - start_).count(); }
+  ProgressSample sample() const {
+    const State& s = sim_.state;
+    return ProgressSample{wall(), double(s.step), s.crackAdvance, s.appliedDisplacement};
+  }
+  void save() {
+    rec_.wallSeconds = wall();
+    rec_.steps = sim_.state.step;
+    writeResultFile(resultFileFor(opt_.outDir, rec_.status), sim_, rec_);
+    lastWrite_ = rec_.wallSeconds;
+  }
+  void checkpoint() {
+    if (opt_.checkpointPath.empty()) return;
+    rec_.wallSeconds = wall();
+    rec_.steps = sim_.state.step;
+    writeCheckpoint(opt_.checkpointPath, sim_, rec_);
+    lastCheckpoint_ = rec_.wallSeconds;
+  }
+  bool fail(const std::string& why) {
+    rec_.status = "failed";
+    rec_.stopReason = why;
+    return false;
+  }
+
+  Simulation& sim_;
+  const RunOptions& opt_;
+  const CaseParams& p_;
+  const clock::time_point start_;
+  const bool tty_;
+  std::vector<double> frameTargets_;
+  const StopTargets stopTargets_;
+  const double minWork_;  // the balance error is checked once this much work was done
+  const std::string partialPath_;  // the result file while the run is in progress
+  long historyEvery_ = 1;
+  RunRecord rec_;
+  double wallBefore_ = 0;  // wall time of the run before a restart
+  double lastWrite_ = 0, lastProgress_ = 0, lastCheckpoint_ = 0, lastDa_ = 0;
+  std::size_t nextFrame_ = 0;
+  ProgressSample pieceStart_, etaSince_;
+};
+
+}  // namespace
+
+RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
+  RunLoop run(sim, opt);
+  run.start();
   while (true) {
     sim.step();
-    if (sim.state.step == injectAt) sim.state.q[sim.freeDofs[sim.freeDofs.size() / 2]] = NAN;
-    const State& s = sim.state;
-    // R-curve point each time the crack advanced.
-    if (s.crackAdvance > lastDa) {
-      if (lastDa == 0) {  // the crack starts: its rate is measured from here, its first advance included
-        etaSince = sample();
-        etaSince.crackAdvance = 0;
-      }
-      lastDa = s.crackAdvance;
-      rec.rcurveDa.push_back(s.crackAdvance);
-      rec.rcurveJ.push_back(sim.computeJ());
-      while (nextFrame < frameTargets.size() && s.crackAdvance >= frameTargets[nextFrame])
-        rec.frames.push_back(captureFrame(sim, frameTargets[nextFrame++]));
+    run.injectFault();
+    run.recordRcurvePoint();
+    if (run.historyDue()) {
+      const Measurement r = run.recordHistory();
+      if (!run.checkBalance(r)) break;
+      run.reportProgress(r);
+      run.saveIfDue();
     }
-    // History, checks and progress every historyEvery steps.
-    if (s.step % historyEvery == 0) {
-      const Measurement r = sim.measure();
-      rec.history.push_back(r);
-      for (double x : {r.J, r.kinetic, r.strainBeams, r.strainInterfaces, r.external})
-        if (!std::isfinite(x)) {
-          fail(fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
-                   "the time step or the loading is unstable", s.step, s.time, r.J, r.kinetic, r.external));
-          break;
-        }
-      if (rec.status == "failed") break;
-      if (r.external > minWork && std::abs(r.balanceError) > kBalanceFail) {
-        fail(fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g): "
-                 "energy is created or lost; reduce dt_factor or the loading rate",
-                 r.balanceError, s.step, kBalanceFail, r.external));
-        break;
-      }
-      if (!warnedBalance && r.external > minWork && std::abs(r.balanceError) > kBalanceWarn) {
-        warnedBalance = true;
-        rec.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
-                                   kBalanceWarn));
-      }
-      const double strain = r.strainBeams + r.strainInterfaces;
-      // Quasi-static check while the crack grows (before it, the ratio only says how far the load has come).
-      const double kineticRatio = s.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
-      rec.maxKineticRatio = std::max(rec.maxKineticRatio, kineticRatio);
-      if (!warnedKinetic && kineticRatio > kKineticWarn) {
-        warnedKinetic = true;
-        rec.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
-                                   kineticRatio, s.step, kKineticWarn));
-      }
-      const double w = wall();
-      if (opt.progress && (w - lastProgress > 2.0)) {
-        lastProgress = w;
-        const ProgressSample now = sample();
-        const double eta = estimateSecondsLeft(etaSince, now, stopTargets);
-        const double rate = now.wall > pieceStart.wall ? (now.step - pieceStart.step) / (now.wall - pieceStart.wall) : 0;
-        std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.1f steps/s  ETA %s%s",
-                     tty ? "\r" : "", s.step, s.time, now.displacement, s.crackAdvance, r.J / Gamma, s.brokenBeams,
-                     rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?", tty ? "   " : "\n");
-      }
-      if (w - lastWrite > opt.writeIntervalSeconds) save();
-    }
-    // Stop criteria.
-    const double U = s.appliedDisplacement;
-    const double maxX = sim.model.a0 + s.crackAdvance;
-    if (s.crackAdvance >= p.stop_da_over_d)
-      rec.stopReason = fmt("crack advance %.3g d reached stop_da_over_d = %g", s.crackAdvance, p.stop_da_over_d);
-    else if (maxX >= sim.model.w_s - 2 * sim.model.h_e)
-      rec.stopReason = fmt("crack reached the far edge (x = %.3g d of w_s = %g d)", maxX, sim.model.w_s);
-    else if (U >= p.stop_u_over_d)
-      rec.stopReason = fmt("applied displacement %.4g d reached stop_u_over_d = %g", U, p.stop_u_over_d);
-    else if (p.max_steps > 0 && s.step >= p.max_steps)
-      rec.stopReason = fmt("step %.0f reached max_steps = %.0f", s.step, double(p.max_steps));
-    else if (gStopSignal)
-      rec.stopReason = fmt("interrupted by signal %.0f", gStopSignal);
-    if (!rec.stopReason.empty()) {
-      rec.status = gStopSignal ? "interrupted" : "completed";
-      if (gStopSignal) checkpoint();  // the state after this step: a restart continues from here
-      break;
-    }
-    if (opt.checkpointIntervalSeconds > 0 && wall() - lastCheckpoint > opt.checkpointIntervalSeconds) checkpoint();
+    if (run.findStopReason()) break;
+    run.checkpointIfDue();
   }
-  if (opt.progress && tty) std::fprintf(stderr, "\n");
-  if (rec.status != "failed" || rec.history.empty() || rec.history.back().step != sim.state.step)
-    rec.history.push_back(sim.measure());
-  rec.frames.push_back(captureFrame(sim, -1.0));
-  save();
-  if (resultFileFor(opt.outDir, rec.status) != partialPath) std::remove(partialPath.c_str());
-  if (rec.status == "completed" && !opt.checkpointPath.empty()) std::remove(opt.checkpointPath.c_str());
-  return rec;
+  return run.finish();
 }
 
 }  // namespace enamel

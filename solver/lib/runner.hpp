@@ -2,6 +2,7 @@
 // The run loop: time steps, R-curve points, history, frames, stop criteria, quasi-static and stability
 // checks, progress on stderr, and the result file (written whole and atomically, also during the run, under
 // a name that says whether the run completed).
+#include <exception>
 #include <string>
 
 #include "checkpoint.hpp"
@@ -17,6 +18,7 @@ struct RunOptions {
   std::string checkpointPath;        // checkpoint file (empty: none)
   double checkpointIntervalSeconds = 0;  // write a checkpoint this often (wall clock; 0: only on SIGINT/SIGTERM)
   bool restart = false;              // continue from checkpointPath instead of starting from rest
+  long injectNanAtStep = -1;         // tests of the failure path: a NaN in the state after this step (-1: none)
 };
 
 /// Run to a stop criterion. While it runs, the partial result is rewritten as DIR/result.partial.h5; at the
@@ -48,6 +50,11 @@ struct StopTargets {
 /// `since`. NaN when no criterion has progressed: before the crack starts only max_steps gives an estimate,
 /// since the displacement limit is usually a far safety net.
 double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop);
+
+/// The exit status (exit_codes.hpp) for an error that ended a command: a bad case (its CaseError's code), a bad
+/// checkpoint 13, a case the integrator refuses or a value out of range 7, anything else (a factorisation
+/// that failed, a file that cannot be written) 11.
+int exitCodeOf(const std::exception& e);
 
 /// Ask a running simulation to stop at the next step (signal handlers call this).
 void requestStop(int signal);

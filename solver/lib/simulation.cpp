@@ -8,7 +8,7 @@
 
 #include <Eigen/CholmodSupport>
 
-#include "integrators.hpp"
+#include "kernels.hpp"
 #include "strength.hpp"
 
 #ifdef _OPENMP
@@ -41,25 +41,12 @@ cohesive::Law lawOf(const CaseParams& p) {
   return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma());
 }
 
-beam::Vec12 gatherElement(const VecX& q, int a, int b) {
-  beam::Vec12 u;
-  u.head<6>() = q.segment<6>(6 * a);
-  u.tail<6>() = q.segment<6>(6 * b);
-  return u;
-}
-
 // Add (sign x) a 12x12 element matrix into a triplet list / an existing sparse pattern.
 void addElementTriplets(std::vector<Eigen::Triplet<double>>& trip, const beam::Mat12& Ke, int a, int b) {
   const int dof[2] = {6 * a, 6 * b};
   for (int i = 0; i < 12; ++i)
     for (int j = 0; j < 12; ++j)
       trip.emplace_back(dof[i / 6] + i % 6, dof[j / 6] + j % 6, Ke(i, j));
-}
-
-void addElementInPlace(SpMat& A, const beam::Mat12& Ke, int a, int b, double sign) {
-  const int dof[2] = {6 * a, 6 * b};
-  for (int i = 0; i < 12; ++i)
-    for (int j = 0; j < 12; ++j) A.coeffRef(dof[i / 6] + i % 6, dof[j / 6] + j % 6) += sign * Ke(i, j);
 }
 
 SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perPly, int nDofs,
@@ -73,21 +60,6 @@ SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perPly, int 
 }
 
 }  // namespace
-
-// --- loading -------------------------------------------------------------------------------------------
-double Loading::velocity(double t) const {
-  if (t >= rampTime) return vApp;
-  return vApp * 0.5 * (1.0 - std::cos(M_PI * t / rampTime));
-}
-double Loading::displacement(double t) const {
-  if (rampTime <= 0) return vApp * t;
-  if (t >= rampTime) return vApp * (0.5 * rampTime + (t - rampTime));
-  return vApp * (0.5 * t - rampTime / (2 * M_PI) * std::sin(M_PI * t / rampTime));
-}
-double Loading::acceleration(double t) const {
-  if (t >= rampTime) return 0.0;
-  return vApp * 0.5 * M_PI / rampTime * std::sin(M_PI * t / rampTime);
-}
 
 // --- static elastic solutions (verification, transverse modulus) ----------------------------------------
 VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values) {
@@ -170,24 +142,30 @@ double measureTransverseModulus(const CaseParams& p, double* blockStrain) {
 
 // --- set-up ---------------------------------------------------------------------------------------------
 Simulation::Simulation(const CaseParams& p)
-    : params(p), model(buildCrossply(geometryOf(p))), section(sectionOf(p)), law(lawOf(p)) {
+    : params(p), model(buildCrossply(geometryOf(p))) {
   const Model& m = model;
   const int n = m.numDofs();
+  Materials& mat = materials;
+  mat.section = sectionOf(p);
+  mat.law = lawOf(p);
+  mat.rodsBreakable = p.rods_breakable;
+  mat.deletionRule = p.deletion_rule;
+  const beam::Section& section = mat.section;
 
   // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
-  beamStrength = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
-  if (!p.rods_breakable) std::fill(beamStrength.begin(), beamStrength.end(), INFINITY);
+  mat.beamStrength = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
+  if (!p.rods_breakable) std::fill(mat.beamStrength.begin(), mat.beamStrength.end(), INFINITY);
 
   // Element matrices: all rods of a ply share one orientation, so one matrix per ply.
   for (int ply = 0; ply < 2; ++ply) {
     const Vec3 xb = m.beamLength * m.rodDirection(ply);
     const beam::Mat3 R = beam::localFrame(Vec3::Zero(), xb);
-    beamK.push_back(beam::globalStiffness(section, Vec3::Zero(), xb));
-    beamMc.push_back(beam::globalConsistentMass(section, Vec3::Zero(), xb));
-    beamMl.push_back(beam::rotateToGlobal(beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(), R));
+    mat.beamK.push_back(beam::globalStiffness(section, Vec3::Zero(), xb));
+    mat.beamMc.push_back(beam::globalConsistentMass(section, Vec3::Zero(), xb));
+    mat.beamMl.push_back(beam::rotateToGlobal(beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(), R));
     beam::Mat12 T = beam::Mat12::Zero();
     for (int blk = 0; blk < 4; ++blk) T.block<3, 3>(3 * blk, 3 * blk) = R;
-    beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
+    mat.beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
   }
   // Rod elements cut by the pre-crack carry no stiffness but keep their material's mass, lumped at their
   // nodes (as a deleted element does), so a rod end isolated by the cut is not massless. Assembled from
@@ -198,47 +176,47 @@ Simulation::Simulation(const CaseParams& p)
     for (int i = 0; i < m.numNodes(); ++i) nodeOf[{m.nodeRod[i], m.nodeSlice[i]}] = i;
     for (std::size_t c = 0; c < m.precrackBeamRod.size(); ++c) {
       const int rod = m.precrackBeamRod[c], k = m.precrackBeamSlice[c];
-      cutBeamNodes.push_back({nodeOf.at({rod, k}), nodeOf.at({rod, k + 1})});
-      addElementTriplets(cutMass, beamMl[m.rodPly[rod]], cutBeamNodes.back()[0], cutBeamNodes.back()[1]);
+      ops.cutBeamNodes.push_back({nodeOf.at({rod, k}), nodeOf.at({rod, k + 1})});
+      addElementTriplets(cutMass, mat.beamMl[m.rodPly[rod]], ops.cutBeamNodes.back()[0], ops.cutBeamNodes.back()[1]);
     }
   }
-  K = assembleBeams(m, beamK, n);
-  M = assembleBeams(m, beamMc, n, cutMass);
-  omegaMaxElement = beam::maxFrequency(section, m.beamLength, beam::MassKind::Consistent);
+  ops.K = assembleBeams(m, mat.beamK, n);
+  ops.M = assembleBeams(m, mat.beamMc, n, cutMass);
+  mat.omegaMaxElement = beam::maxFrequency(section, m.beamLength, beam::MassKind::Consistent);
 
   // Wave speed and Rayleigh damping (paper eq. 1-3, DESIGN section 4): C = a M + b K,
   // a = zeta w_min, b = zeta / w_min, w_min = pi c_d / h_s.
-  E_transverse = p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p);
-  c_d = std::sqrt(E_transverse / 1.0);
-  omegaMin = M_PI * c_d / m.h_s;
-  dampA = p.zeta * omegaMin;
-  dampB = p.zeta / omegaMin;
-  loading.vApp = p.rate_factor * p.v_app_over_cd * c_d;
-  loading.rampTime = p.ramp_transits * m.h_s / c_d;
+  mat.E_transverse = p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p);
+  mat.c_d = std::sqrt(mat.E_transverse / 1.0);
+  mat.omegaMin = M_PI * mat.c_d / m.h_s;
+  mat.dampA = p.zeta * mat.omegaMin;
+  mat.dampB = p.zeta / mat.omegaMin;
+  mat.loading.vApp = p.rate_factor * p.v_app_over_cd * mat.c_d;
+  mat.loading.rampTime = p.ramp_transits * m.h_s / mat.c_d;
 
   // Prescribed DOFs: u_y of the top (+) and bottom (-) rows, graded 1 - x/w_s.
-  dofToFree.assign(n, 0);
+  ops.dofToFree.assign(n, 0);
   auto prescribe = [&](const std::vector<int>& nodes, double sign) {
     for (int node : nodes) {
-      prescribedDofs.push_back(6 * node + 1);
-      prescribedShape.push_back(sign * (1.0 - m.X[node].x() / m.w_s));
-      dofToFree[6 * node + 1] = -1;
+      ops.prescribedDofs.push_back(6 * node + 1);
+      ops.prescribedShape.push_back(sign * (1.0 - m.X[node].x() / m.w_s));
+      ops.dofToFree[6 * node + 1] = -1;
     }
   };
   prescribe(m.topNodes, +1.0);
   prescribe(m.bottomNodes, -1.0);
   for (int i = 0; i < n; ++i)
-    if (dofToFree[i] == 0) { dofToFree[i] = static_cast<int>(freeDofs.size()); freeDofs.push_back(i); }
+    if (ops.dofToFree[i] == 0) { ops.dofToFree[i] = static_cast<int>(ops.freeDofs.size()); ops.freeDofs.push_back(i); }
 
   // Node -> interface ends (CSR), for the deterministic gather.
-  nodeIfaceStart.assign(m.numNodes() + 1, 0);
-  for (const auto& ab : m.ifaceNodes) { ++nodeIfaceStart[ab[0] + 1]; ++nodeIfaceStart[ab[1] + 1]; }
-  for (int i = 0; i < m.numNodes(); ++i) nodeIfaceStart[i + 1] += nodeIfaceStart[i];
-  nodeIfaceList.resize(nodeIfaceStart.back());
-  std::vector<int> fill(nodeIfaceStart.begin(), nodeIfaceStart.end() - 1);
+  ops.nodeIfaceStart.assign(m.numNodes() + 1, 0);
+  for (const auto& ab : m.ifaceNodes) { ++ops.nodeIfaceStart[ab[0] + 1]; ++ops.nodeIfaceStart[ab[1] + 1]; }
+  for (int i = 0; i < m.numNodes(); ++i) ops.nodeIfaceStart[i + 1] += ops.nodeIfaceStart[i];
+  ops.nodeIfaceList.resize(ops.nodeIfaceStart.back());
+  std::vector<int> fill(ops.nodeIfaceStart.begin(), ops.nodeIfaceStart.end() - 1);
   for (int i = 0; i < m.numInterfaces(); ++i) {
-    nodeIfaceList[fill[m.ifaceNodes[i][0]]++] = 2 * i;
-    nodeIfaceList[fill[m.ifaceNodes[i][1]]++] = 2 * i + 1;
+    ops.nodeIfaceList[fill[m.ifaceNodes[i][0]]++] = 2 * i;
+    ops.nodeIfaceList[fill[m.ifaceNodes[i][1]]++] = 2 * i + 1;
   }
 
   state.q = VecX::Zero(n);
@@ -246,15 +224,15 @@ Simulation::Simulation(const CaseParams& p)
   state.a = VecX::Zero(n);
   state.lambdaMax.assign(m.numInterfaces(), 0.0);
   state.beamBroken.assign(m.numBeams(), 0);
-  reaction = VecX::Zero(prescribedDofs.size());
-  deletionRule = p.deletion_rule;
+  state.reaction = VecX::Zero(ops.prescribedDofs.size());
 
 #ifdef _OPENMP
   // threads = 0: automatic, one thread per 30k DOF up to all cores (small models run faster on one).
   omp_set_num_threads(p.threads > 0 ? static_cast<int>(p.threads)
                                     : std::max(1, std::min(omp_get_num_procs(), n / 30000)));
 #endif
-  integrator = makeIntegrator(*this);
+  integrator = makeIntegrator(p, model, materials, ops);
+  if (integrator->usesHalfStepVelocity()) state.vHalf = VecX::Zero(n);
 }
 
 Simulation::~Simulation() = default;
@@ -268,142 +246,88 @@ int threadCount() {
 }
 
 void Simulation::solveStaticElastic(double U) {
-  const SpMat Kt = assembleElasticStiffness(model, beamK, &state.beamBroken, law);
-  std::vector<int> dofs = prescribedDofs;
+  const SpMat Kt = assembleElasticStiffness(model, materials.beamK, &state.beamBroken, materials.law);
+  std::vector<int> dofs = ops.prescribedDofs;
   std::vector<double> values;
-  for (double sh : prescribedShape) values.push_back(sh * U);
+  for (double sh : ops.prescribedShape) values.push_back(sh * U);
   const int anchor = model.bottomNodes[0];  // against rigid translation in x and z
   dofs.insert(dofs.end(), {6 * anchor, 6 * anchor + 2});
   values.insert(values.end(), {0.0, 0.0});
   state.q = solveStaticPrescribed(Kt, dofs, values);
   state.v.setZero();
   state.a.setZero();
+  state.vHalf.setZero();
   state.appliedDisplacement = U;
   const VecX f = Kt * state.q;
-  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) reaction[i] = f[prescribedDofs[i]];
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) state.reaction[i] = f[ops.prescribedDofs[i]];
 }
 
-// --- kernels -------------------------------------------------------------------------------------------
-void Simulation::applyBoundaryConditions(double t) {
-  const double U = loading.displacement(t), V = loading.velocity(t), A = loading.acceleration(t);
-  state.appliedDisplacement = U;
-  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) {
-    state.q[prescribedDofs[i]] = prescribedShape[i] * U;
-    state.v[prescribedDofs[i]] = prescribedShape[i] * V;
-    state.a[prescribedDofs[i]] = prescribedShape[i] * A;
-  }
-}
+// --- the level above a scheme's step -------------------------------------------------------------------
 
-void Simulation::computeForcesForInterfaces(const VecX& q, VecX& f, bool update) {
-  const Model& m = model;
-  const int ni = m.numInterfaces();
-  std::vector<cohesive::Vec3>& forceOnB = ifaceForceOnB;
-  forceOnB.resize(ni);
-  int failed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : failed)
-  for (int i = 0; i < ni; ++i) {
-    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-    double lm = state.lambdaMax[i];
-    forceOnB[i] = cohesive::computeInterfaceForceOnB(law, m.ifaceGeom[i], q.segment<3>(6 * A),
-                                                     q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
-                                                     q.segment<3>(6 * B + 3), lm);
-    if (update) state.lambdaMax[i] = lm;
-    failed += cohesive::isFailed(law, lm);
-  }
-  if (update) state.failedInterfaces = failed;
-  // f_iface = -(forces exerted on the nodes), gathered per node in the fixed CSR order; the force on A and
-  // both moments follow from the force on B as in cohesive::computeInterfaceForces, one side at a time.
-#pragma omp parallel for schedule(static)
-  for (int node = 0; node < m.numNodes(); ++node) {
-    Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
-    for (int k = nodeIfaceStart[node]; k < nodeIfaceStart[node + 1]; ++k) {
-      const int i = nodeIfaceList[k] >> 1;
-      const cohesive::InterfaceGeometry& g = m.ifaceGeom[i];
-      if (nodeIfaceList[k] & 1) {
-        F += forceOnB[i];
-        Mo += g.armB.cross(forceOnB[i]);
-      } else {
-        const Vec3 forceA = -forceOnB[i];
-        F += forceA;
-        Mo += g.armA.cross(forceA);
-      }
-    }
-    f.segment<3>(6 * node) = -F;
-    f.segment<3>(6 * node + 3) = -Mo;
-  }
-}
-
-void Simulation::computeStressRatiosForBeams(const VecX& q, std::vector<double>& ratio) const {
-  const Model& m = model;
-  ratio.assign(m.numBeams(), 0.0);
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < m.numBeams(); ++e) {
-    if (state.beamBroken[e]) continue;
-    const beam::Vec12 fl = beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
-                           gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
-    ratio[e] = beam::maxTensileStress(section, fl) / beamStrength[e];
-  }
-}
-
-// Deletion rule (DESIGN section 3), independent of element order and thread count:
-//  "most_overloaded": delete the element(s) with the largest stress ratio >= 1, ties within 1e-9
-//                     relative (mirror-symmetric rods) deleted together; the rest are re-evaluated next step.
-//  "all":             delete every element with ratio >= 1.
-// A deleted element's stiffness (and its stiffness damping) is removed; its consistent mass is replaced by
-// the lumped mass of the same element, so no material mass vanishes and no node is left massless (the paper
-// subtracts M_e, eq. 17; see README "Model"). The strain energy it held, and the kinetic energy change of
-// the mass lumping, are booked as rod fracture energy.
-int Simulation::deleteOverloadedBeams() {
-  lastDeleted.clear();
-  if (!params.rods_breakable) return 0;
-  std::vector<double>& ratio = beamStressRatio;
-  computeStressRatiosForBeams(state.q, ratio);
-  double worst = 0;
-  for (double r : ratio) worst = std::max(worst, r);
-  if (worst < 1.0) return 0;
-  const double threshold = deletionRule == "all" ? 1.0 : worst * (1.0 - 1e-9);
-  for (int e = 0; e < model.numBeams(); ++e)
-    if (!state.beamBroken[e] && ratio[e] >= threshold) lastDeleted.push_back(e);
-  for (int e : lastDeleted) {
-    const int a = model.beamNodes[e][0], b = model.beamNodes[e][1];
-    const int ply = model.rodPly[model.beamRod[e]];
-    const beam::Vec12 u = gatherElement(state.q, a, b), v = gatherElement(state.v, a, b);
-    const beam::Mat12& Ml = beamMl[ply];
-    state.rodFractureEnergy += 0.5 * u.dot(beamK[ply] * u);
-    if (integrator->usesConsistentMass()) state.rodFractureEnergy += 0.5 * v.dot((beamMc[ply] - Ml) * v);
-    removeBeamFromMatrices(e);
-    state.beamBroken[e] = 1;
-    state.deletionOrder.push_back(e);
-    ++state.brokenBeams;
-  }
-  integrator->onBeamsDeleted(*this);
-  return static_cast<int>(lastDeleted.size());
-}
-
-// K loses the element's stiffness; M keeps its lumped mass (consistent minus lumped is removed).
-void Simulation::removeBeamFromMatrices(int e) {
-  const int a = model.beamNodes[e][0], b = model.beamNodes[e][1];
-  const int ply = model.rodPly[model.beamRod[e]];
-  addElementInPlace(K, beamK[ply], a, b, -1.0);
-  addElementInPlace(M, beamMc[ply] - beamMl[ply], a, b, -1.0);
-}
-
-void Simulation::replayDeletions() {
-  for (int e : state.deletionOrder) removeBeamFromMatrices(e);
-  if (!state.deletionOrder.empty()) integrator->onBeamsDeleted(*this);
-}
-
-/// One time step: advance positions, boundary conditions, forces for beams and interfaces, accelerations and
-/// velocities (the integrator); delete overloaded rods; track the crack when something broke.
+/// One time step: the scheme's step; delete overloaded rods; measure the crack when something broke.
 void Simulation::step() {
   const int failedBefore = state.failedInterfaces;
-  integrator->advance(*this);
+  integrator->advance(model, materials, ops, state);
   const int deleted = deleteOverloadedBeams();
   if (deleted > 0 || state.failedInterfaces != failedBefore) state.crackAdvance = measureCrackAdvance();
 }
 
+namespace {
+
+// Deletion rule (DESIGN section 3), independent of element order and thread count:
+//  "most_overloaded": the element(s) with the largest stress ratio >= 1, ties within 1e-9 relative
+//                     (mirror-symmetric rods) together; the rest are re-evaluated next step.
+//  "all":             every element with ratio >= 1.
+std::vector<int> findOverloadedBeams(const std::vector<double>& ratio, const std::vector<std::uint8_t>& beamBroken,
+                                     const std::string& rule) {
+  double worst = 0;
+  for (double r : ratio) worst = std::max(worst, r);
+  if (worst < 1.0) return {};
+  const double threshold = rule == "all" ? 1.0 : worst * (1.0 - 1e-9);
+  std::vector<int> overloaded;
+  for (std::size_t e = 0; e < ratio.size(); ++e)
+    if (!beamBroken[e] && ratio[e] >= threshold) overloaded.push_back(static_cast<int>(e));
+  return overloaded;
+}
+
+// Book the energy a deleted rod element releases as rod fracture energy: its strain energy 1/2 u^T K_e u,
+// and with a consistent mass the kinetic energy of the mass lumping 1/2 v^T (M_e,consistent - M_e,lumped) v.
+void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool consistentMass, State& s) {
+  const int a = m.beamNodes[e][0], b = m.beamNodes[e][1];
+  const int ply = m.rodPly[m.beamRod[e]];
+  const beam::Vec12 u = gatherElement(s.q, a, b), v = gatherElement(s.v, a, b);
+  s.rodFractureEnergy += 0.5 * u.dot(mat.beamK[ply] * u);
+  if (consistentMass) s.rodFractureEnergy += 0.5 * v.dot((mat.beamMc[ply] - mat.beamMl[ply]) * v);
+}
+
+}  // namespace
+
+// A deleted element's stiffness (and its stiffness damping) is removed; its consistent mass is replaced by
+// the lumped mass of the same element, so no material mass vanishes and no node is left massless (the paper
+// subtracts M_e, eq. 17; see README "Model"). The energy it held is booked as rod fracture energy.
+int Simulation::deleteOverloadedBeams() {
+  lastDeleted.clear();
+  if (!materials.rodsBreakable) return 0;
+  computeStressRatiosForBeams(model, materials, state.q, state.beamBroken, beamStressRatio_);
+  lastDeleted = findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule);
+  if (lastDeleted.empty()) return 0;
+  for (int e : lastDeleted) {
+    bookEnergyOfDeletedBeam(model, materials, e, integrator->usesConsistentMass(), state);
+    removeBeamFromMatrices(model, materials, e, ops);
+    state.beamBroken[e] = 1;
+    state.deletionOrder.push_back(e);
+  }
+  integrator->updateOperators(ops);
+  return static_cast<int>(lastDeleted.size());
+}
+
+void Simulation::replayDeletions() {
+  for (int e : state.deletionOrder) removeBeamFromMatrices(model, materials, e, ops);
+  if (!state.deletionOrder.empty()) integrator->updateOperators(ops);
+}
+
 // --- measurements ---------------------------------------------------------------------------------------
-double Simulation::strainEnergyOfBeams() const { return 0.5 * state.q.dot(K * state.q); }
+double Simulation::strainEnergyOfBeams() const { return 0.5 * state.q.dot(ops.K * state.q); }
 
 double Simulation::strainEnergyOfInterfaces() const {
   // Energies per interface in parallel, then one sum in a fixed order: the result (and so the energy
@@ -416,7 +340,7 @@ double Simulation::strainEnergyOfInterfaces() const {
     const auto& g = m.ifaceGeom[i];
     const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
                                                          state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
-    energy[i] = g.area * cohesive::storedEnergyDensity(law, open, state.lambdaMax[i]);
+    energy[i] = g.area * cohesive::storedEnergyDensity(materials.law, open, state.lambdaMax[i]);
   }
   return std::accumulate(energy.begin(), energy.end(), 0.0);
 }
@@ -424,19 +348,19 @@ double Simulation::strainEnergyOfInterfaces() const {
 double Simulation::fractureEnergyOfInterfaces() const {
   double sum = 0;
   for (int i = 0; i < model.numInterfaces(); ++i)
-    sum += model.ifaceGeom[i].area * cohesive::dissipatedEnergyDensity(law, state.lambdaMax[i]);
+    sum += model.ifaceGeom[i].area * cohesive::dissipatedEnergyDensity(materials.law, state.lambdaMax[i]);
   return sum;
 }
 
 int Simulation::countFailedInterfaces() const {
   int n = 0;
-  for (double lm : state.lambdaMax) n += cohesive::isFailed(law, lm);
+  for (double lm : state.lambdaMax) n += cohesive::isFailed(materials.law, lm);
   return n;
 }
 
 int Simulation::countInelasticInterfaces() const {
   int n = 0;
-  for (double lm : state.lambdaMax) n += cohesive::isInelastic(law, lm);
+  for (double lm : state.lambdaMax) n += cohesive::isInelastic(materials.law, lm);
   return n;
 }
 
@@ -449,16 +373,16 @@ double Simulation::computeJ() const {
   const Model& m = model;
   const double U = state.appliedDisplacement;
   double sumFdudx = 0;
-  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) {
-    const double dudx = prescribedShape[i] >= 0 ? -U / m.w_s : U / m.w_s;
-    sumFdudx += reaction[i] * dudx;
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
+    const double dudx = ops.prescribedShape[i] >= 0 ? -U / m.w_s : U / m.w_s;
+    sumFdudx += state.reaction[i] * dudx;
   }
   auto faceEnergyDensity = [&](int slice, int segment) {
     double eb = 0, ei = 0;
     for (int e = 0; e < m.numBeams(); ++e) {
       if (state.beamBroken[e] || m.nodeSlice[m.beamNodes[e][0]] != segment) continue;
       const beam::Vec12 u = gatherElement(state.q, m.beamNodes[e][0], m.beamNodes[e][1]);
-      eb += 0.5 * u.dot(beamK[m.rodPly[m.beamRod[e]]] * u);
+      eb += 0.5 * u.dot(materials.beamK[m.rodPly[m.beamRod[e]]] * u);
     }
     for (int i = 0; i < m.numInterfaces(); ++i) {
       if (m.ifaceSlice[i] != slice) continue;
@@ -466,7 +390,7 @@ double Simulation::computeJ() const {
       const auto& g = m.ifaceGeom[i];
       const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
                                                            state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
-      ei += g.area * cohesive::storedEnergyDensity(law, open, state.lambdaMax[i]);
+      ei += g.area * cohesive::storedEnergyDensity(materials.law, open, state.lambdaMax[i]);
     }
     return eb / m.h_e + ei / (0.5 * m.h_e);
   };
@@ -499,7 +423,7 @@ double Simulation::measureCrackAdvance() const {
     addElem((m.precrackBeamSlice[i] + 0.5) * m.h_e, true,
             {{m.precrackBeamRod[i], m.precrackBeamSlice[i]}, {m.precrackBeamRod[i], m.precrackBeamSlice[i] + 1}});
   for (int i = 0; i < m.numInterfaces(); ++i) {
-    if (!cohesive::isFailed(law, state.lambdaMax[i])) continue;
+    if (!cohesive::isFailed(materials.law, state.lambdaMax[i])) continue;
     const int k = m.ifaceSlice[i];
     addElem(k * m.h_e, false, {{m.nodeRod[m.ifaceNodes[i][0]], k}, {m.nodeRod[m.ifaceNodes[i][1]], k}});
   }
@@ -541,14 +465,14 @@ double Simulation::measureCrackAdvance() const {
   return std::max(0.0, maxX - m.a0);
 }
 
-Measurement Simulation::measure() {
+Measurement Simulation::measure() const {
   Measurement r;
   r.step = state.step;
   r.time = state.time;
   r.appliedDisplacement = state.appliedDisplacement;
   r.J = computeJ();
   r.crackAdvance = state.crackAdvance;
-  r.kinetic = integrator->kineticEnergy(*this);
+  r.kinetic = integrator->kineticEnergy(ops, state);
   r.strainBeams = strainEnergyOfBeams();
   r.strainInterfaces = strainEnergyOfInterfaces();
   r.damping = state.dampingWork;
@@ -557,11 +481,11 @@ Measurement Simulation::measure() {
   r.external = state.externalWork;
   const double stored = r.kinetic + r.strainBeams + r.strainInterfaces + r.damping + r.fracture + r.rodFracture;
   r.balanceError = r.external > 0 ? (r.external - stored) / r.external : 0.0;
-  r.brokenBeams = state.brokenBeams;
+  r.brokenBeams = state.brokenBeams();
   r.failedInterfaces = countFailedInterfaces();
   r.inelasticInterfaces = countInelasticInterfaces();
   double P = 0;
-  for (std::size_t i = 0; i < prescribedDofs.size(); ++i) P += reaction[i] * prescribedShape[i];
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) P += state.reaction[i] * ops.prescribedShape[i];
   r.load = P;
   return r;
 }

@@ -28,7 +28,7 @@ CaseParams bundleCase(const std::string& extra) {
 // Give every rod the same axial field u_x = u(x), v_x = v(x), nothing else; grips held at rest.
 template <class U, class V>
 void setAxialField(Simulation& sim, U u, V v) {
-  sim.loading.vApp = 0;
+  sim.materials.loading.vApp = 0;
   sim.state.q.setZero();
   sim.state.v.setZero();
   sim.state.a.setZero();
@@ -37,7 +37,7 @@ void setAxialField(Simulation& sim, U u, V v) {
     sim.state.q[6 * node] = u(x);
     sim.state.v[6 * node] = v(x);
   }
-  sim.integrator->initialise(sim);
+  sim.integrator->initialise(sim.model, sim.materials, sim.ops, sim.state);
 }
 
 // Centroid along x of u_x^2 (the pulse position).
@@ -90,14 +90,14 @@ TEST(Dynamics, UndampedElasticRunConservesEnergy) {
                              "w_s_over_d = 10\nh_s_over_d = 6\nzeta = 0\nv_app_over_cd = 0.01\n"
                              "integrator = \"" + std::string(integrator) + "\"\n",
                              "drift", "", {}));
-    const double T = 3 * sim.loading.rampTime;  // ramp up, then two ramp times at constant grip velocity
+    const double T = 3 * sim.materials.loading.rampTime;  // ramp up, then two ramp times at constant grip velocity
     double worst = 0, injected = 0;
     for (int check = 1; check <= 30; ++check) {
       advanceTo(sim, T * check / 30.0);
-      const double stored = sim.integrator->kineticEnergy(sim) + sim.strainEnergyOfBeams() +
+      const double stored = sim.integrator->kineticEnergy(sim.ops, sim.state) + sim.strainEnergyOfBeams() +
                             sim.strainEnergyOfInterfaces();
       injected = sim.state.externalWork;
-      const bool judged = std::string(integrator) == "paper" || sim.state.time >= sim.loading.rampTime;
+      const bool judged = std::string(integrator) == "paper" || sim.state.time >= sim.materials.loading.rampTime;
       if (injected > 0 && judged) worst = std::max(worst, std::abs(injected - stored) / injected);
     }
     std::cout << "[ measured ] " << integrator << ": largest energy error " << worst << "\n";
@@ -115,7 +115,7 @@ TEST(Dynamics, SingleModeDampingRatioMatchesRayleigh) {
   double L = 0;
   for (const auto& x : sim.model.X) L = std::max(L, x.x());
   const double w1 = M_PI / L;
-  const double expected = 0.5 * (sim.dampA / w1 + sim.dampB * w1);
+  const double expected = 0.5 * (sim.materials.dampA / w1 + sim.materials.dampB * w1);
   ASSERT_GT(expected, 0.05);
   setAxialField(sim, [&](double x) { return 1e-3 * std::cos(M_PI * x / L); }, [](double) { return 0.0; });
   // modal coordinate: projection of u_x on the mode shape

@@ -26,7 +26,7 @@ Static solveAt(double theta, double a0) {
   const double U = 0.01;
   sim.solveStaticElastic(U);
   double P = 0;
-  for (std::size_t i = 0; i < sim.prescribedDofs.size(); ++i) P += sim.reaction[i] * sim.prescribedShape[i];
+  for (std::size_t i = 0; i < sim.ops.prescribedDofs.size(); ++i) P += sim.state.reaction[i] * sim.ops.prescribedShape[i];
   // crack length of the discrete model: midway between the last cut slice and the first intact one
   const int lastCut = static_cast<int>(std::ceil(a0 / sim.model.h_e)) - 1;
   return {P, sim.computeJ(), sim.strainEnergyOfBeams() + sim.strainEnergyOfInterfaces(),

@@ -1,0 +1,114 @@
+#include "kernels.hpp"
+
+#include <cmath>
+
+namespace enamel {
+
+// --- loading -------------------------------------------------------------------------------------------
+double Loading::velocity(double t) const {
+  if (t >= rampTime) return vApp;
+  return vApp * 0.5 * (1.0 - std::cos(M_PI * t / rampTime));
+}
+double Loading::displacement(double t) const {
+  if (rampTime <= 0) return vApp * t;
+  if (t >= rampTime) return vApp * (0.5 * rampTime + (t - rampTime));
+  return vApp * (0.5 * t - rampTime / (2 * M_PI) * std::sin(M_PI * t / rampTime));
+}
+double Loading::acceleration(double t) const {
+  if (t >= rampTime) return 0.0;
+  return vApp * 0.5 * M_PI / rampTime * std::sin(M_PI * t / rampTime);
+}
+
+beam::Vec12 gatherElement(const VecX& q, int a, int b) {
+  beam::Vec12 u;
+  u.head<6>() = q.segment<6>(6 * a);
+  u.tail<6>() = q.segment<6>(6 * b);
+  return u;
+}
+
+// --- prescribed DOFs: u_p = shape_p U(t) ------------------------------------------------------------------
+void prescribeDisplacements(const Operators& ops, const Loading& loading, double t, State& s) {
+  const double U = loading.displacement(t);
+  s.appliedDisplacement = U;
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) s.q[ops.prescribedDofs[i]] = ops.prescribedShape[i] * U;
+}
+
+void prescribeVelocities(const Operators& ops, double V, VecX& v) {
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) v[ops.prescribedDofs[i]] = ops.prescribedShape[i] * V;
+}
+
+void applyBoundaryConditions(const Operators& ops, const Loading& loading, double t, State& s) {
+  prescribeDisplacements(ops, loading, t, s);
+  prescribeVelocities(ops, loading.velocity(t), s.v);
+  prescribeVelocities(ops, loading.acceleration(t), s.a);
+}
+
+// --- interfaces ----------------------------------------------------------------------------------------
+// f_iface = -(forces exerted on the nodes): per interface F_B (in parallel), then per node the sum over its
+// interface ends in the fixed CSR order of the wrench on that side.
+int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
+                               std::vector<double>& lambdaMax, bool update, std::vector<cohesive::Vec3>& forceOnB,
+                               VecX& f) {
+  const int ni = m.numInterfaces();
+  forceOnB.resize(ni);
+  int failed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : failed)
+  for (int i = 0; i < ni; ++i) {
+    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+    double lm = lambdaMax[i];
+    forceOnB[i] = cohesive::computeInterfaceForceOnB(law, m.ifaceGeom[i], q.segment<3>(6 * A),
+                                                     q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
+                                                     q.segment<3>(6 * B + 3), lm);
+    if (update) lambdaMax[i] = lm;
+    failed += cohesive::isFailed(law, lm);
+  }
+#pragma omp parallel for schedule(static)
+  for (int node = 0; node < m.numNodes(); ++node) {
+    Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
+    for (int k = ops.nodeIfaceStart[node]; k < ops.nodeIfaceStart[node + 1]; ++k) {
+      const int i = ops.nodeIfaceList[k] >> 1;
+      const cohesive::Wrench w = cohesive::wrenchOnSide(m.ifaceGeom[i], forceOnB[i], ops.nodeIfaceList[k] & 1);
+      F += w.force;
+      Mo += w.moment;
+    }
+    f.segment<3>(6 * node) = -F;
+    f.segment<3>(6 * node + 3) = -Mo;
+  }
+  return failed;
+}
+
+// --- rod elements --------------------------------------------------------------------------------------
+// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e
+double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
+  const beam::Vec12 fl = mat.beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
+                         gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
+  return beam::maxTensileStress(mat.section, fl);
+}
+
+void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
+                                 const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio) {
+  ratio.assign(m.numBeams(), 0.0);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < m.numBeams(); ++e) {
+    if (beamBroken[e]) continue;
+    ratio[e] = computeStressOfBeam(m, mat, q, e) / mat.beamStrength[e];
+  }
+}
+
+namespace {
+void addElementInPlace(SpMat& A, const beam::Mat12& Ke, int a, int b, double sign) {
+  const int dof[2] = {6 * a, 6 * b};
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) A.coeffRef(dof[i / 6] + i % 6, dof[j / 6] + j % 6) += sign * Ke(i, j);
+}
+}  // namespace
+
+// K -= K_e;  M -= (M_e,consistent - M_e,lumped)
+void removeBeamFromMatrices(const Model& m, const Materials& mat, int e, Operators& ops) {
+  const int a = m.beamNodes[e][0], b = m.beamNodes[e][1];
+  const int ply = m.rodPly[m.beamRod[e]];
+  addElementInPlace(ops.K, mat.beamK[ply], a, b, -1.0);
+  addElementInPlace(ops.M, mat.beamMc[ply] - mat.beamMl[ply], a, b, -1.0);
+}
+
+}  // namespace enamel

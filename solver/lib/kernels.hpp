@@ -1,0 +1,38 @@
+#pragma once
+// Kernels: loops over one kind of thing (interfaces, rod elements, prescribed DOFs) on plain data
+// (state.hpp). No I/O. The time integrators (integrators.hpp) and the simulation (simulation.hpp) call them.
+#include <vector>
+
+#include "state.hpp"
+
+namespace enamel {
+
+/// The 12 DOFs (uA, thA, uB, thB) of the element between nodes a and b.
+beam::Vec12 gatherElement(const VecX& q, int a, int b);
+
+/// u_p = shape_p U(t) at the prescribed DOFs, and s.appliedDisplacement = U(t).
+void prescribeDisplacements(const Operators& ops, const Loading& loading, double t, State& s);
+/// v_p = shape_p V at the prescribed DOFs of a velocity vector v.
+void prescribeVelocities(const Operators& ops, double V, VecX& v);
+/// q, v and a of the prescribed DOFs at time t (U, U', U'').
+void applyBoundaryConditions(const Operators& ops, const Loading& loading, double t, State& s);
+
+/// f_iface (eq. 8): internal force vector of all interfaces for displacements q. Each interface's force on
+/// its node B (cohesive::computeInterfaceForceOnB) goes to forceOnB (scratch, resized); the nodal wrenches
+/// (cohesive::wrenchOnSide) are gathered per node in the fixed CSR order, so f does not depend on the thread
+/// count. lambdaMax is updated only when `update` (a trial evaluation leaves the history untouched).
+/// Returns the number of failed interfaces (with the history as updated, or as it would be).
+int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
+                               std::vector<double>& lambdaMax, bool update, std::vector<cohesive::Vec3>& forceOnB,
+                               VecX& f);
+
+/// Largest tensile stress of rod element e (units of E_r): beam::maxTensileStress of its local end forces.
+double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e);
+/// Stress ratio sigma / sigma_ru of every intact rod element (0 for deleted ones): the deletion check.
+void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
+                                 const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio);
+
+/// Take rod element e out of K (its stiffness) and M (consistent minus lumped mass: its lumped mass stays).
+void removeBeamFromMatrices(const Model& m, const Materials& mat, int e, Operators& ops);
+
+}  // namespace enamel

@@ -1,0 +1,89 @@
+#pragma once
+// The plain data a run is made of (DESIGN.md sections 3-5), in four parts that change at different rates:
+//   Model      the geometry (geometry.hpp): nodes, rod elements, interfaces; never changes
+//   Materials  what the rods and interfaces are made of, how the specimen is damped and loaded; never changes
+//   Operators  the assembled rod matrices K, M (rod deletions change them), DOF maps, interface adjacency
+//   State      everything a time step changes; with the case, all that a checkpoint holds
+// A scheme's own data (lumped mass, dt, its factorisation) lives in the scheme (integrators.hpp).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+
+#include "beam.hpp"
+#include "cohesive.hpp"
+#include "geometry.hpp"
+
+namespace enamel {
+
+using VecX = Eigen::VectorXd;
+using SpMat = Eigen::SparseMatrix<double>;
+
+/// Graded velocity loading on the top and bottom boundary rows (DESIGN section 4):
+///   u_y = +/- U(t) (1 - x / w_s),  U' = v_app r(t),  r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
+struct Loading {
+  double vApp = 0;      // peak applied velocity at the cracked edge
+  double rampTime = 0;  // T_r
+  double displacement(double t) const;
+  double velocity(double t) const;
+  double acceleration(double t) const;
+};
+
+/// Set up once from the case; a run never changes it.
+struct Materials {
+  beam::Section section;
+  cohesive::Law law;
+  std::vector<double> beamStrength;  // sigma_ru per rod element
+  bool rodsBreakable = true;
+  std::string deletionRule;          // case key deletion_rule
+  // per ply (all rods of a ply share one orientation): K_local T (u_e -> local end forces), and the global
+  // element stiffness, consistent mass and lumped mass
+  std::vector<beam::Mat12> beamLocalForceOperator, beamK, beamMc, beamMl;
+  double omegaMaxElement = 0;        // largest beam-element frequency (consistent mass)
+  double E_transverse = 0, c_d = 0;  // transverse modulus and wave speed
+  double omegaMin = 0, dampA = 0, dampB = 0;  // Rayleigh: C = dampA M + dampB K
+  Loading loading;
+};
+
+/// The assembled operators. K and M hold the rods only (interfaces are never assembled) and lose a rod
+/// element's stiffness (and consistent-minus-lumped mass) when it is deleted.
+struct Operators {
+  SpMat K, M;
+  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s).
+  std::vector<int> prescribedDofs;
+  std::vector<double> prescribedShape;
+  std::vector<int> freeDofs;
+  std::vector<int> dofToFree;                    // index into freeDofs; -1 for prescribed
+  std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack
+  // Interface adjacency (node -> interface ends) for a deterministic gather of interface forces.
+  std::vector<int> nodeIfaceStart, nodeIfaceList;  // CSR; entries are 2*iface + side (0 = A, 1 = B)
+};
+
+/// Everything that changes during a run (checkpointable: checkpoint.cpp lists every field once).
+struct State {
+  long step = 0;
+  double time = 0;
+  double appliedDisplacement = 0;      // U: u_y of the top row at the cracked edge
+  VecX q;                              // displacements/rotations at t_n (6 per node)
+  VecX v, a;                           // velocities and accelerations at t_n (`paper`; `lumped`: v is the
+                                       // initial velocity `initialise` starts from, a unused)
+  VecX vHalf;                          // half-step velocity v_{n-1/2} (`lumped`; empty for `paper`)
+  VecX reaction;                       // force the grips apply at each prescribed DOF (last step)
+  std::vector<double> lambdaMax;       // per interface: largest effective separation reached
+  std::vector<std::uint8_t> beamBroken;  // per rod element: deleted
+  std::vector<int> deletionOrder;        // rod elements in the order they were deleted (K, M are rebuilt so)
+  // energy accumulators (time integrals)
+  double externalWork = 0;             // int F_reaction . v_prescribed dt
+  double dampingWork = 0;              // int v . C v dt
+  double rodFractureEnergy = 0;        // strain (and mass-lumping kinetic) energy released by deleted rods
+  double lastExternalPower = 0;        // grip power where the last interval of externalWork ended
+  int failedInterfaces = 0;            // at the last update of the interface history
+  double crackAdvance = 0;             // Delta a (d)
+
+  int brokenBeams() const { return static_cast<int>(deletionOrder.size()); }
+};
+
+}  // namespace enamel
