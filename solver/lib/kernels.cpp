@@ -51,16 +51,20 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
                                VecX& f) {
   const int ni = m.numInterfaces();
   forceOnB.resize(ni);
+  // Private to each thread, so that they stay in registers (Eigen's vector stores may alias anything: shared
+  // pointers are reloaded after every interface): the law, and where the histories and forces go.
+  const cohesive::Law lawHere = law;
+  double* lambda = lambdaMax.data();
+  cohesive::Vec3* onB = forceOnB.data();
   int failed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : failed)
+#pragma omp parallel for schedule(static) reduction(+ : failed) firstprivate(lawHere, lambda, onB)
   for (int i = 0; i < ni; ++i) {
     const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-    double lm = lambdaMax[i];
-    forceOnB[i] = cohesive::computeInterfaceForceOnB(law, m.ifaceGeom[i], q.segment<3>(6 * A),
-                                                     q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
-                                                     q.segment<3>(6 * B + 3), lm);
-    if (update) lambdaMax[i] = lm;
-    failed += cohesive::isFailed(law, lm);
+    double lm = lambda[i];
+    onB[i] = cohesive::computeInterfaceForceOnB(lawHere, m.ifaceGeom[i], q.segment<3>(6 * A), q.segment<3>(6 * A + 3),
+                                                q.segment<3>(6 * B), q.segment<3>(6 * B + 3), lm);
+    if (update) lambda[i] = lm;
+    failed += cohesive::isFailed(lawHere, lm);
   }
 #pragma omp parallel for schedule(static)
   for (int node = 0; node < m.numNodes(); ++node) {
@@ -78,11 +82,17 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 }
 
 // --- rod elements --------------------------------------------------------------------------------------
-// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e
-double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
+namespace {
+// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e (here, so the loop below inlines it)
+double stressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
   const beam::Vec12 fl = mat.beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
                          gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
   return beam::maxTensileStress(mat.section, fl);
+}
+}  // namespace
+
+double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
+  return stressOfBeam(m, mat, q, e);
 }
 
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
@@ -91,7 +101,7 @@ void computeStressRatiosForBeams(const Model& m, const Materials& mat, const Vec
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < m.numBeams(); ++e) {
     if (beamBroken[e]) continue;
-    ratio[e] = computeStressOfBeam(m, mat, q, e) / mat.beamStrength[e];
+    ratio[e] = stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
   }
 }
 
