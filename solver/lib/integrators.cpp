@@ -94,7 +94,6 @@ class PaperIntegrator : public Integrator {
     advancePositions(s);
     advanceClock(s, dt_);
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    fI_.resize(s.q.size());
     s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
     computeForcesForBeams(ops, s);
     solveAccelerations(ops, s);
@@ -107,7 +106,6 @@ class PaperIntegrator : public Integrator {
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    fI_.resize(s.q.size());
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
     r_ = -fI_ - ops.K * s.q - dampB_ * (ops.K * s.v) - dampA_ * (ops.M * s.v);
     solveAccelerations(ops, s);
@@ -392,10 +390,9 @@ class LumpedIntegrator : public Integrator {
   }
 
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    fI_.resize(s.q.size());
     s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
-    multiplyTwo(Kblocks_, s.q, s.vHalf, Kq_, Kv_);  // forces for beams: K q_n, K v_{n-1/2}
-    gatherGrips(ops, s.vHalf, vGripBefore_);
+    computeForcesForBeams(s);
+    gatherGrips(ops, s.vHalf, vGripBefore_);  // v_{n-1/2} of the grips, for their reactions
     advanceVelocities(s);
     prescribeVelocities(ops, mat.loading.velocity(s.time + 0.5 * dt_), s.vHalf);
     computeReactions(ops, s);
@@ -408,7 +405,6 @@ class LumpedIntegrator : public Integrator {
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    fI_.resize(s.q.size());
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
     const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
     s.vHalf = s.v;
@@ -425,6 +421,9 @@ class LumpedIntegrator : public Integrator {
   }
 
  private:
+  // K q_n and K v_{n-1/2} in one pass over K
+  void computeForcesForBeams(const State& s) { multiplyTwo(Kblocks_, s.q, s.vHalf, Kq_, Kv_); }
+
   // v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 (K q_n + f_iface + b' K v_{n-1/2})] / (1 + a dt/2)
   void advanceVelocities(State& s) const {
     const double a = dampA_, dt = dt_;

@@ -51,6 +51,7 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
                                VecX& f) {
   const int ni = m.numInterfaces();
   forceOnB.resize(ni);
+  f.resize(m.numDofs());
   // Private to each thread, so that they stay in registers (Eigen's vector stores may alias anything: shared
   // pointers are reloaded after every interface): the law, and where the histories and forces go.
   const cohesive::Law lawHere = law;

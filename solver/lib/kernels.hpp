@@ -20,7 +20,8 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
 /// f_iface (eq. 8): internal force vector of all interfaces for displacements q. Each interface's force on
 /// its node B (cohesive::computeInterfaceForceOnB) goes to forceOnB (scratch, resized); the nodal wrenches
 /// (cohesive::wrenchOnSide) are gathered per node in the fixed CSR order, so f does not depend on the thread
-/// count. lambdaMax is updated only when `update` (a trial evaluation leaves the history untouched).
+/// count; f is resized to the DOFs. lambdaMax is updated only when `update` (a trial evaluation leaves the
+/// history untouched).
 /// Returns the number of failed interfaces (with the history as updated, or as it would be).
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, std::vector<cohesive::Vec3>& forceOnB,
