@@ -84,8 +84,9 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 
 // --- rod elements --------------------------------------------------------------------------------------
 namespace {
-// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e (here, so the loop below inlines it)
-double stressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
+// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e. Always inlined: the deletion check
+// below runs it for every rod element at every step (a call costs ~20% of that loop).
+[[gnu::always_inline]] inline double stressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
   const beam::Vec12 fl = mat.beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
                          gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
   return beam::maxTensileStress(mat.section, fl);
