@@ -36,7 +36,7 @@ Frame captureFrame(const Simulation& sim, double targetDa) {
   f.beamBroken = sim.state.beamBroken;
   f.beamStress.resize(sim.model.numBeams());
   for (int e = 0; e < sim.model.numBeams(); ++e)
-    f.beamStress[e] = sim.state.beamBroken[e] ? NAN
+    f.beamStress[e] = sim.state.beamBroken[e] ? 0.0f
         : static_cast<float>(computeStressOfBeam(sim.model, sim.materials, sim.state.q, e) / sim.params.sigma0());
   return f;
 }
@@ -329,7 +329,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
         dataset(fg.id, "beam_broken", f.beamBroken, 1, "-", "1 = rod element deleted");
         dataset(fg.id, "beam_stress", f.beamStress, 1, "sigma0",
                 "largest tensile stress of the rod element / sigma0 (the solver's deletion check, "
-                "kernels.cpp computeStressOfBeam); NaN for deleted elements");
+                "kernels.cpp computeStressOfBeam); 0 for deleted elements (beam_broken)");
       }
     }
     if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("HDF5: cannot flush '" + tmp + "'");

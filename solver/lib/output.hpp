@@ -21,7 +21,7 @@ struct Frame {
   std::vector<float> ifaceDamage;           // 1 - S/k
   std::vector<std::uint8_t> ifaceState;     // 0 elastic, 1 inelastic (process zone), 2 failed
   std::vector<std::uint8_t> beamBroken;
-  std::vector<float> beamStress;            // per rod element: kernels.hpp computeStressOfBeam / sigma0; NaN deleted
+  std::vector<float> beamStress;            // per rod element: kernels.hpp computeStressOfBeam / sigma0; 0 deleted
 };
 
 struct RunRecord {
