@@ -39,6 +39,7 @@ class Frame:
     iface_damage: np.ndarray    # 1 - secant stiffness / k
     beam_broken: np.ndarray     # 1 = rod element deleted
     node_displacement: np.ndarray  # (nodes, 6): ux uy uz rx ry rz, d and rad
+    beam_stress: np.ndarray     # (beams,), sigma0: the solver's brittle-check stress (0 for deleted elements)
 
 
 @dataclasses.dataclass
@@ -126,7 +127,8 @@ def read_frames(frames_group) -> list[Frame]:
         a = attributes(fg)
         out.append(Frame(index=int(name), target_da=float(a["target_da_over_d"]), da=float(a["da_over_d"]),
                          step=int(a["step"]), iface_state=fg["iface_state"][:], iface_damage=fg["iface_damage"][:],
-                         beam_broken=fg["beam_broken"][:], node_displacement=fg["node_displacement"][:]))
+                         beam_broken=fg["beam_broken"][:], node_displacement=fg["node_displacement"][:],
+                         beam_stress=fg["beam_stress"][:]))
     return out
 
 

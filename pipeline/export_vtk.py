@@ -6,8 +6,8 @@
 Two series, both in the reference configuration (apply "Warp By Vector" with `displacement` to deform):
   rods        line cells, one per rod (beam) element, between its two nodes.
               cell data: broken (1 = deleted), strength_over_sigma0, stress_over_sigma0 (the solver's brittle
-              criterion recomputed from the frame's nodal displacements and rotations: axial N/A plus the larger
-              end bending stress, sigma0 units; NaN for deleted elements), stress_ratio (stress / strength: the
+              criterion as the solver computed it, /frames/<n>/beam_stress: axial N/A plus the larger end
+              bending stress, sigma0 units; NaN for deleted elements), stress_ratio (stress / strength: the
               element is deleted when it reaches 1). point data: displacement (ux, uy, uz), rotation (rx, ry, rz),
               radius (d/2, the rod's extreme fibre: ParaView's Tube filter, "Vary Radius: By Absolute Scalar").
   interfaces  quad cells, one per interface: the shared Voronoi face of its two rods, in the interface's plane
@@ -41,59 +41,6 @@ import numpy as np
 from enamel_results.results import EXIT_MISSING, MissingResult, load_result
 
 ROD_RADIUS = 0.5  # d: the extreme fibre c of both sections (hexagon across flats d, circle of diameter d)
-
-
-# --- rod stress: the solver's check (solver/lib/beam.cpp maxTensileStress), vectorised over elements ---
-def section_properties(name: str, d: float = 1.0) -> dict:
-    """Hexagon (across flats d): A = sqrt(3)/2 d^2, Iy = Iz = 5 sqrt(3)/144 d^4; circle: A = pi d^2/4,
-    Iy = Iz = pi d^4/64; extreme fibre c = d/2 for both (beam.hpp)."""
-    if name == "circle":
-        return dict(A=np.pi * d ** 2 / 4, I=np.pi * d ** 4 / 64, c=d / 2)
-    return dict(A=np.sqrt(3) / 2 * d ** 2, I=5 * np.sqrt(3) / 144 * d ** 4, c=d / 2)
-
-
-def local_frames(xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
-    """Rows e1 (a -> b), e2, e3 per element: e3 = normalize(z - (z.e1) e1), e2 = e3 x e1; parallel to z:
-    e2 = x, e3 = e1 x e2 (beam.cpp localFrame). Shape (n, 3, 3)."""
-    e1 = xb - xa
-    e1 /= np.linalg.norm(e1, axis=1)[:, None]
-    z = np.array([0.0, 0.0, 1.0])
-    zp = z[None, :] - e1[:, 2:3] * e1
-    nz = np.linalg.norm(zp, axis=1)
-    ok = nz > 1e-8
-    e3 = np.zeros_like(e1)
-    e2 = np.zeros_like(e1)
-    e3[ok] = zp[ok] / nz[ok, None]
-    e2[ok] = np.cross(e3[ok], e1[ok])
-    e2[~ok] = np.array([1.0, 0.0, 0.0])
-    e3[~ok] = np.cross(e1[~ok], e2[~ok])
-    return np.stack([e1, e2, e3], axis=1)
-
-
-def rod_stress(X: np.ndarray, beam_nodes: np.ndarray, q6: np.ndarray, section: dict, E: float = 1.0):
-    """Max tensile stress of each element (units of E_r) from nodal displacements/rotations q6 (nodes, 6):
-       sigma = N/A + max_end sqrt((My c/Iy)^2 + (Mz c/Iz)^2),  N = EA/L (u'_b - u'_a),
-       end moments from the Hermite bending stiffness EI/L^3 [12 6L -12 6L; 6L 4L^2 -6L 2L^2; ...] acting on
-       (v_a, theta_z,a, v_b, theta_z,b) in x'y' and on (w_a, -theta_y,a, w_b, -theta_y,b) in x'z' (local axes)."""
-    a, b = beam_nodes[:, 0], beam_nodes[:, 1]
-    xa, xb = X[a], X[b]
-    L = np.linalg.norm(xb - xa, axis=1)
-    R = local_frames(xa, xb)
-    loc = lambda v: np.einsum("nij,nj->ni", R, v)  # noqa: E731
-    ua, ra, ub, rb = loc(q6[a, :3]), loc(q6[a, 3:]), loc(q6[b, :3]), loc(q6[b, 3:])
-    A, I, c = section["A"], section["I"], section["c"]
-    N = E * A / L * (ub[:, 0] - ua[:, 0])
-    k = E * I / L ** 3
-
-    def end_moments(w0, t0, w1, t1):  # rows 2 and 4 of the Hermite block: moments at ends a and b
-        ma = k * (6 * L * w0 + 4 * L ** 2 * t0 - 6 * L * w1 + 2 * L ** 2 * t1)
-        mb = k * (6 * L * w0 + 2 * L ** 2 * t0 - 6 * L * w1 + 4 * L ** 2 * t1)
-        return ma, mb
-
-    mz_a, mz_b = end_moments(ua[:, 1], ra[:, 2], ub[:, 1], rb[:, 2])
-    my_a, my_b = end_moments(ua[:, 2], -ra[:, 1], ub[:, 2], -rb[:, 1])
-    bend = np.maximum(np.hypot(my_a, mz_a), np.hypot(my_b, mz_b)) * c / I
-    return N / A + bend
 
 
 # --- interface faces ---
@@ -174,15 +121,13 @@ def add_nodes_per_element(path: pathlib.Path) -> None:
 
 
 def rod_data(r, frame) -> dict:
-    """Point and cell data of the rods in one frame. The stress is recomputed here (rod_stress) until the solver
-    writes it: the one place to switch to /frames/<n>/beam_stress."""
+    """Point and cell data of the rods in one frame; the stress is the solver's own (/frames/<n>/beam_stress, the
+    brittle check's axial plus larger end bending stress), NaN for deleted elements."""
     g = r.geometry
     q = frame.node_displacement.astype(np.float64)
     strength = g.beam_strength.astype(np.float64)
-    section = section_properties(str(r.params.get("section", "hexagon")))
-    stress = rod_stress(g.node_position.astype(np.float64), g.beam_nodes, q, section) / float(r.meta["sigma0"])
     broken = frame.beam_broken.astype(np.uint8)
-    stress = np.where(broken > 0, np.nan, stress)
+    stress = np.where(broken > 0, np.nan, frame.beam_stress.astype(np.float64))
     return dict(point_data={"displacement": q[:, :3], "rotation": q[:, 3:],
                             "radius": np.full(len(q), ROD_RADIUS)},
                 cell_data={"broken": [broken], "strength_over_sigma0": [strength],
