@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "kernels.hpp"
+#include "resources.hpp"
 #include "strength.hpp"
 #include "version.hpp"
 
@@ -100,16 +101,7 @@ RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<d
 namespace {
 
 // Peak resident memory of this process (VmHWM of /proc/self/status) in MB; NaN where there is no /proc.
-double peakMemoryMB() {
-  std::FILE* f = std::fopen("/proc/self/status", "r");
-  if (!f) return NAN;
-  char line[256];
-  double kb = NAN;
-  while (std::fgets(line, sizeof line, f))
-    if (std::sscanf(line, "VmHWM: %lf kB", &kb) == 1) break;
-  std::fclose(f);
-  return kb / 1024.0;
-}
+double peakMemoryMB() { return readProcKilobytes("/proc/self/status", "VmHWM") / 1024.0; }
 
 // --- a thin RAII layer over the HDF5 C API ---
 struct Handle {

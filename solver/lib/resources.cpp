@@ -33,16 +33,19 @@ ResourceEstimate estimateResources(const CaseParams& p) {
   return e;
 }
 
-double availableMemoryBytes() {
-  std::FILE* f = std::fopen("/proc/meminfo", "r");
+double readProcKilobytes(const char* path, const char* key) {
+  std::FILE* f = std::fopen(path, "r");
   if (!f) return NAN;
+  const std::string format = std::string(key) + ": %lf kB";
   char line[256];
   double kb = NAN;
   while (std::fgets(line, sizeof line, f))
-    if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+    if (std::sscanf(line, format.c_str(), &kb) == 1) break;
   std::fclose(f);
-  return kb * 1024;
+  return kb;
 }
+
+double availableMemoryBytes() { return readProcKilobytes("/proc/meminfo", "MemAvailable") * 1024; }
 
 std::string checkMemoryFits(const CaseParams& p, double available) {
   const ResourceEstimate e = estimateResources(p);

@@ -23,6 +23,10 @@ struct ResourceEstimate {
 /// the nodes of a slice (the bandwidth). Within ~10% of the measured peaks, on the high side.
 ResourceEstimate estimateResources(const CaseParams& p);
 
+/// The value in kB of the line "KEY: N kB" of a /proc file such as /proc/meminfo or /proc/self/status (NaN
+/// where there is no such file or line).
+double readProcKilobytes(const char* path, const char* key);
+
 /// MemAvailable of /proc/meminfo in bytes (NaN where there is none).
 double availableMemoryBytes();
 
