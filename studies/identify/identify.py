@@ -15,8 +15,8 @@ Stages (default "ap"; each only as far as --stop-starting allows):
   b    the same at red with h_e 0.15 (mesh convergence)
   c    the size `big` (80 x 40 d) for the candidates
   d    the validation cases at red for the candidates
-  p    after a, one queue: for each candidate h_e 0.15 and big, then the validation cases, then h_e 0.15 for
-       the other values (what the rule needs first)
+  p    after a, one queue: for each candidate in turn h_e 0.15, big and its validation cases, then h_e 0.15
+       for the other values (what the rule needs first)
 The candidates are computed from the red h_e 0.3 results present when the stage starts: the G whose R_ss is
 nearest 7 and its neighbour in G on the other side of 7 (or the next nearest), preferring mesh-converged values.
 """
@@ -88,7 +88,7 @@ def rod_break_positions(r) -> dict:
     """Where the deleted rod elements are: x relative to the pre-crack tip in crisscross spacings p = d/sin(theta),
     crisscross offset (y distance to the nearest other-ply rod in the element's first slice, over s/2), and the
     median spacing of groups of broken elements (the sawtooth period)."""
-    out = dict(xx_offset_median=math.nan, xx_offset_mean=math.nan, sawtooth_period=math.nan, x_breaks="")
+    out = dict(xx_offset_median=math.nan, xx_offset_mean=math.nan, xx_offset_near_median=math.nan, sawtooth_period=math.nan, x_breaks="")
     g = r.geometry
     theta = math.radians(float(r.param("theta_D")))
     if g is None or not r.frames or theta == 0:
@@ -100,13 +100,16 @@ def rod_break_positions(r) -> dict:
     xc = float(g.attrs.get("x_crisscross", g.attrs.get("a0", math.nan)))  # first crisscross point on the mid-plane
     p = 1.0 / math.sin(theta)
     half_s = 0.5 / math.cos(theta)
-    offs, xs = [], []
+    offs, offs2, xs = [], [], []
+
+    def offset(n):
+        other = (ply != ply[n]) & (np.abs(pos[:, 0] - pos[n, 0]) < 1e-6)
+        return float(np.min(np.abs(pos[other, 1] - pos[n, 1]))) / half_s if other.any() else math.nan
+
     for b in broken:
         n1, n2 = g.beam_nodes[b]
-        x1, y1 = pos[n1, 0], pos[n1, 1]
-        other = (ply != ply[n1]) & (np.abs(pos[:, 0] - x1) < 1e-6)
-        if other.any():
-            offs.append(float(np.min(np.abs(pos[other, 1] - y1))) / half_s)
+        offs.append(offset(n1))
+        offs2.append(min(offset(n1), offset(n2)))
         xs.append(0.5 * (pos[n1, 0] + pos[n2, 0]))
     xs = np.sort(np.array(xs))
     groups, cur = [], [xs[0]]
@@ -119,6 +122,10 @@ def rod_break_positions(r) -> dict:
     groups.append(np.mean(cur))
     out["xx_offset_median"] = float(np.median(offs)) if offs else math.nan
     out["xx_offset_mean"] = float(np.mean(offs)) if offs else math.nan
+    # post hoc (added after the first results were seen, NOT used by the README's statement 5): the offset at
+    # the nearer end of the element; the first-node offset moves by 4 h_e sin(theta)/d (0.6 at h_e 0.3, theta 30)
+    # from one element to the next, so the element nearest a crisscross point has a first-node offset up to 0.6
+    out["xx_offset_near_median"] = float(np.nanmedian(offs2)) if offs2 else math.nan
     if len(groups) > 1:
         out["sawtooth_period"] = float(np.median(np.diff(groups)))
     out["x_breaks"] = " ".join(f"{(x - xc) / p:.2f}" for x in groups)  # group centres, in p from x_crisscross
@@ -174,9 +181,9 @@ def stage_jobs(stage: str, runs: pathlib.Path) -> list[tuple]:
     if stage == "p":  # after a: one queue, most needed first (the rule needs mesh and size for the candidates)
         cand = candidates(runs)
         jobs = []
-        for G in cand:
+        for G in cand:  # per candidate: mesh, size, then its validation cases (so the first one is complete)
             jobs += [("red", 0.15, G, MAIN_CASE), ("big", 0.3, G, MAIN_CASE)]
-        jobs += [("red", 0.3, G, c) for G in cand for c in VALIDATION_CASES]
+            jobs += [("red", 0.3, G, c) for c in VALIDATION_CASES]
         jobs += [("red", 0.15, G, MAIN_CASE) for G in G_VALUES if G not in cand]
         return jobs
     raise SystemExit(f"identify: unknown stage {stage!r} (a, b, c, d, p)")
@@ -204,45 +211,45 @@ def candidates(runs: pathlib.Path, n: int = 2) -> list[float]:
     return [G for G in pick if G is not None][:n]
 
 
-def run_all(jobs, args) -> None:
-    """Run the jobs, at most args.jobs at once, none started after args.stop_starting; skip finished ones."""
-    todo = [j for j in jobs if not (run_dir(*j, runs=args.runs) / "result.h5").is_file()]
-    done = len(jobs) - len(todo)
-    if done:
-        print(f"identify: {done} of {len(jobs)} runs already finished")
-    running = []
+def run_all(plan, args) -> None:
+    """Run the jobs of plan() in order, at most args.jobs at once, none started after args.stop_starting; skip
+    finished ones. plan() is re-evaluated each time a slot frees, so a queue that depends on results (stage p:
+    the candidates) uses every run finished by then; a run that failed is not retried in this session."""
+    running, tried = [], set()
 
     def too_late():
-        if not args.stop_starting:
-            return False
-        now = datetime.datetime.now().strftime("%H:%M")
-        return now >= args.stop_starting
+        return bool(args.stop_starting) and datetime.datetime.now().strftime("%H:%M") >= args.stop_starting
 
-    while todo or running:
-        while todo and len(running) < args.jobs and not too_late():
-            j = todo.pop(0)
-            d = run_dir(*j, runs=args.runs)
-            d.mkdir(parents=True, exist_ok=True)
-            cmd = solver_cmd(args.binary, *j, d, args.threads, args.checkpoint_every, args.nice)
-            log = open(d / "log.txt", "a")
-            log.write(f"== {datetime.datetime.now():%F %T} identify: {' '.join(cmd)}\n")
-            log.flush()
-            print(f"identify: start {d.relative_to(ROOT)}", flush=True)
-            running.append((j, subprocess.Popen(cmd, stdout=log, stderr=log), time.time(), log))
-        if todo and too_late() and not running:
-            print(f"identify: not starting {len(todo)} runs after {args.stop_starting}", flush=True)
+    def todo():
+        busy = {j for j, *_ in running}
+        return [j for j in plan() if j not in busy and j not in tried
+                and not (run_dir(*j, runs=args.runs) / "result.h5").is_file()]
+
+    while True:
+        if len(running) < args.jobs and not too_late():
+            for j in todo()[: args.jobs - len(running)]:
+                tried.add(j)
+                d = run_dir(*j, runs=args.runs)
+                d.mkdir(parents=True, exist_ok=True)
+                cmd = solver_cmd(args.binary, *j, d, args.threads, args.checkpoint_every, args.nice)
+                log = open(d / "log.txt", "a")
+                log.write(f"== {datetime.datetime.now():%F %T} identify: {' '.join(cmd)}\n")
+                log.flush()
+                print(f"identify: {datetime.datetime.now():%H:%M} start {d.relative_to(ROOT)}", flush=True)
+                running.append((j, subprocess.Popen(cmd, stdout=log, stderr=log), time.time(), log))
+        if not running:
+            left = todo()
+            if left:
+                print(f"identify: not starting {len(left)} runs after {args.stop_starting}", flush=True)
             break
-        time.sleep(2)
+        time.sleep(5)
         for item in list(running):
             j, p, t0, log = item
             if p.poll() is not None:
                 running.remove(item)
                 log.close()
-                print(f"identify: {'done' if p.returncode == 0 else f'exit {p.returncode}'} "
+                print(f"identify: {datetime.datetime.now():%H:%M} {'done' if p.returncode == 0 else f'exit {p.returncode}'} "
                       f"{run_dir(*j, runs=args.runs).relative_to(ROOT)} ({time.time() - t0:.0f} s)", flush=True)
-        if too_late() and todo and not running:
-            print(f"identify: not starting {len(todo)} runs after {args.stop_starting}", flush=True)
-            break
 
 
 # --- the report ------------------------------------------------------------------------------------------------
@@ -293,7 +300,18 @@ def convergence(rows) -> list[dict]:
                 and size_l2 <= CONVERGED_L2)
         status = ("converged" if conv else
                   "not established" if math.isnan(mesh) or math.isnan(size_l2) else "not converged")
-        out.append(dict(G=G, mesh_l2=mesh, size_pair=pair, size_l2=size_l2, l2_ci_red=l2_ci_red,
+        def drss(a, ref):  # supplementary (not the rule): mean R over the common Delta_a range, relative difference
+            if not a or not ref:
+                return math.nan
+            ra, rr = a["_r"], ref["_r"]
+            grid = np.linspace(max(ra.da[0], rr.da[0]), min(ra.da[-1], rr.da[-1]), 50)
+            ma, mr = np.interp(grid, ra.da, ra.R).mean(), np.interp(grid, rr.da, rr.R).mean()
+            return (ma - mr) / mr
+
+        mesh_drss = drss(coarse, fine)
+        size_drss = drss(get(sizes[-2], 0.3, G), get(sizes[-1], 0.3, G)) if len(sizes) >= 2 else math.nan
+        out.append(dict(G=G, mesh_l2=mesh, mesh_dRss=mesh_drss, size_dRss=size_drss, size_pair=pair,
+                        size_l2=size_l2, l2_ci_red=l2_ci_red,
                         l2_red_big=l2_red_big, largest=sizes[-1] if sizes else "-",
                         R_ss_largest=largest["R_ss"] if largest else math.nan, status=status))
     return out
@@ -398,6 +416,42 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
     plt.close(fig)
     made.append("rcurves.png")
 
+    # where the rods break: broken elements over the crisscross lattice (theta30 (21.4, 10), every G, red and big)
+    brk = [m for m in main if m["h_e"] == 0.3 and m["size"] in ("red", "big") and m["broken_rods"]]
+    if brk:
+        fig, axes = plt.subplots(len(brk), 1, figsize=(12, 1.6 * len(brk) + 0.6), squeeze=False)
+        for ax, m in zip(axes[:, 0], brk):
+            r = m["_r"]
+            g = r.geometry
+            th = math.radians(float(r.param("theta_D")))
+            p, s = 1 / math.sin(th), 1 / math.cos(th)
+            xc, yc = float(g.attrs["x_crisscross"]), float(g.attrs["y_crack_plane"])
+            xmax = (float(g.attrs["w_s"]) - xc) / p
+            xmin = -xc / p
+            n = np.arange(math.floor(2 * xmin), math.ceil(2 * xmax) + 1)
+            for k in n:
+                ys = (np.arange(-4, 5) + (0.5 if k % 2 else 0.0)) * s
+                ax.plot(np.full(ys.size, k / 2), ys, ".", color="0.75", ms=3)
+            b = np.flatnonzero(r.frames[-1].beam_broken > 0)
+            mid = 0.5 * (g.node_position[g.beam_nodes[b, 0]] + g.node_position[g.beam_nodes[b, 1]])
+            ply = g.node_ply[g.beam_nodes[b, 0]]
+            for pl, mk, col in ((0, "^", "C3"), (1, "v", "C0")):
+                sel = ply == pl
+                ax.plot((mid[sel, 0] - xc) / p, mid[sel, 1] - yc, mk, color=col, ms=6,
+                        label=f"ply {pl + 1} ({'+' if pl == 0 else '-'}theta)")
+            ax.axhline(0, color="k", lw=0.5)
+            ax.set_xlim(-1, (m["da_max"] / p) + 1.5)
+            ax.set_ylim(-3.5, 3.5)
+            ax.set_ylabel("y - y_crack (d)", fontsize=8)
+            ax.set_title(f"{m['size']} G = {m['G']:g}: {m['broken_rods']} broken rod elements, median crisscross offset "
+                         f"{fmt(m['xx_offset_median'], '.2f')} (grey: crisscross points)", fontsize=9)
+            ax.legend(fontsize=7, loc="upper right")
+        axes[-1, 0].set_xlabel("(x - x_c) / (d / sin theta_D): crisscross spacing along the mid-plane")
+        fig.tight_layout()
+        fig.savefig(out_dir / "breaks.png", dpi=80)
+        plt.close(fig)
+        made.append("breaks.png")
+
     val = [m for m in rows if m["case"] != MAIN_CASE or (m["size"], m["h_e"]) == ("red", 0.3)]
     Gs = sorted({m["G"] for m in val if m["case"] != MAIN_CASE})
     if Gs:
@@ -446,7 +500,7 @@ def report(args) -> None:
     out = args.report_dir
     out.mkdir(parents=True, exist_ok=True)
     cols = ["size", "w_s", "h_s", "h_e", "G", "case", "status", "da_max", "R_init", "R_ss", "R_m", "R_at3", "R_end",
-            "broken_rods", "da_first_rod", "xx_offset_median", "xx_offset_mean", "sawtooth_period", "x_breaks",
+            "broken_rods", "da_first_rod", "xx_offset_median", "xx_offset_mean", "xx_offset_near_median", "sawtooth_period", "x_breaks",
             "E_T", "l_over_d", "delta_f_over_d", "wall_s", "path"]
     with open(out / "results.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
@@ -465,24 +519,27 @@ def report(args) -> None:
          "under `runs/identify/` (not committed); `results.csv` and `convergence.csv` hold them all.", "",
          "## Runs", "",
          "| case | size | h_e | G | l/d | delta_f/d | status | Delta_a | R_init | R(3 d) | R_ss | R_m | broken | "
-         "first rod at | crisscross offset (median) | sawtooth period / d | break groups ((x - x_c)/(d/sin)) | wall s |",
+         "first rod at | crisscross offset (median; nearer end, post hoc) | sawtooth period / d | break groups ((x - x_c)/(d/sin)) | wall s |",
          "|" + "---|" * 18]
     for m in rows:
         L.append(f"| {m['case']} | {m['size']} {m['w_s']}x{m['h_s']} | {m['h_e']:g} | {m['G']:g} | {fmt(m['l_over_d'])} | "
                  f"{fmt(m['delta_f_over_d'])} | {m['status']} | {fmt(m['da_max'])} | {fmt(m['R_init'])} | "
                  f"{fmt(m['R_at3'])} | {fmt(m['R_ss'])} | {fmt(m['R_m'])} | {m['broken_rods']} | "
-                 f"{fmt(m['da_first_rod'])} | {fmt(m['xx_offset_median'], '.2f')} | {fmt(m['sawtooth_period'])} | "
+                 f"{fmt(m['da_first_rod'])} | {fmt(m['xx_offset_median'], '.2f')}; {fmt(m['xx_offset_near_median'], '.2f')} | "
+                 f"{fmt(m['sawtooth_period'])} | "
                  f"{m['x_breaks'] or '-'} | {fmt(m['wall_s'], '.0f')} |")
     L += ["", "l = E_T Gamma_i/sigma0^2 (E_T: /meta E_transverse_over_Er); delta_f = (G + 1) sigma0/k. "
           "R_ss: mean R over the last 20% of the advance reached. Unfinished runs (status running/interrupted) "
           "are listed but never used by the rule.", "",
           "## Convergence (theta30 (21.4, 10), relative L2 of R-curves, common Delta_a range)", "",
           "| G | mesh: red h_e 0.3 vs 0.15 | size: ci vs red | size: red vs big | rule's size pair | size L2 used | "
-          "largest size | R_ss there | status |", "|---|---|---|---|---|---|---|---|---|"]
+          "largest size | R_ss there | status | mean-R diff over the common range, mesh / size (not the rule) |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
     for c in conv:
         L.append(f"| {c['G']:g} | {pct(c['mesh_l2'])} | {pct(c['l2_ci_red'])} | "
                  f"{pct(c['l2_red_big'])} | {c['size_pair']} | {pct(c['size_l2'])} | "
-                 f"{c['largest']} | {fmt(c['R_ss_largest'])} | {c['status']} |")
+                 f"{c['largest']} | {fmt(c['R_ss_largest'])} | {c['status']} | "
+                 f"{pct(c['mesh_dRss'])} / {pct(c['size_dRss'])} |")
     L += ["", "## Selection (the README's rule, applied as written)", ""]
     if sel:
         L.append(f"**Selected: G = {sel['G']:g}** (converged; theta30 (21.4, 10) R_ss {sel['R_ss_largest']:.2f} at "
@@ -521,16 +578,16 @@ def main(argv=None) -> int:
     p.add_argument("--dry-run", action="store_true", help="print the runs that would be made, run nothing")
     args = p.parse_args(argv)
     if args.only is not None:
-        groups = [[(s, float(h), float(G), c) for s, h, G, c in (o.split(":") for o in args.only)]]
+        fixed = [(sz, float(h), float(G), c) for sz, h, G, c in (o.split(":") for o in args.only)]
+        plan = lambda: fixed  # noqa: E731
     else:
-        groups = [("stage", st) for st in args.stages]
-    for g in groups:
-        jobs = stage_jobs(g[1], args.runs) if g and g[0] == "stage" else g
-        if args.dry_run:
-            for j in jobs:
-                print(run_dir(*j, runs=args.runs).relative_to(ROOT), " ".join(solver_cmd(args.binary, *j, "OUT", args.threads, args.checkpoint_every, args.nice)))
-            continue
-        run_all(jobs, args)
+        plan = lambda: [j for st in args.stages for j in stage_jobs(st, args.runs)]  # noqa: E731
+    if args.dry_run:
+        for j in plan():
+            print(run_dir(*j, runs=args.runs).relative_to(ROOT),
+                  " ".join(solver_cmd(args.binary, *j, "OUT", args.threads, args.checkpoint_every, args.nice)))
+        return 0
+    run_all(plan, args)
     if not args.dry_run:
         report(args)
     return 0
