@@ -222,8 +222,10 @@ def run_all(plan, args) -> None:
 
     def todo():
         busy = {j for j, *_ in running}
+        late = bool(args.no_long_after) and datetime.datetime.now().strftime("%H:%M") >= args.no_long_after
         return [j for j in plan() if j not in busy and j not in tried
-                and not (run_dir(*j, runs=args.runs) / "result.h5").is_file()]
+                and not (run_dir(*j, runs=args.runs) / "result.h5").is_file()
+                and not (late and (j[0] == "big" or j[1] < 0.3))]
 
     while True:
         if len(running) < args.jobs and not too_late():
@@ -569,6 +571,9 @@ def main(argv=None) -> int:
     p.add_argument("--checkpoint-every", type=float, default=60, help="checkpoint interval, s (default 60)")
     p.add_argument("--stop-starting", default=os.environ.get("IDENTIFY_STOP_STARTING", ""),
                    help="HH:MM: start no run at or after this local time (default: none)")
+    p.add_argument("--no-long-after", default=os.environ.get("IDENTIFY_NO_LONG_AFTER", ""),
+                   help="HH:MM: from this time on start no long run (big size or h_e < 0.3, ~45 min each here), "
+                        "only the others (default: none)")
     p.add_argument("--only", nargs="*", default=None,
                    help="explicit runs SIZE:H_E:G:CASE instead of the stages (e.g. big:0.3:8:theta30_s21.4_e10_cv0)")
     p.add_argument("--binary", type=pathlib.Path,
