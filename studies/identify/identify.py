@@ -419,7 +419,7 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
     made.append("rcurves.png")
 
     # where the rods break: broken elements over the crisscross lattice (theta30 (21.4, 10), every G, red and big)
-    brk = [m for m in main if m["h_e"] == 0.3 and m["size"] in ("red", "big") and m["broken_rods"]]
+    brk = [m for m in main if m["h_e"] == 0.3 and m["size"] in ("red", "big") and m["broken_rods"] and m["_r"].frames]
     if brk:
         fig, axes = plt.subplots(len(brk), 1, figsize=(12, 1.6 * len(brk) + 0.6), squeeze=False)
         for ax, m in zip(axes[:, 0], brk):
