@@ -22,6 +22,8 @@
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
 #                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
 #                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
+#   make identify       [IDENTIFY_ARGS=...]  issue 17's interface-ductility study: niced resumable runs in
+#                       runs/identify/, report studies/identify/results.md (studies/identify/README.md)
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 
@@ -53,8 +55,8 @@ PRESETS := ci reduced paper
 RUNS := runs
 FIG_OUT := figures/out/$(PRESET)
 
-.PHONY: bench bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all vtk \
-  reference clean-runs check-preset slurm
+.PHONY: bench bench-paper identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
+  vtk reference clean-runs check-preset slurm
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -92,6 +94,11 @@ clean:
 
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.run_bench --jobs $(JOBS)
+
+# Issue 17: the interface-ductility identification study (studies/identify/README.md); resumable, niced runs in
+# runs/identify/, report in studies/identify/. IDENTIFY_ARGS: e.g. --stages ab --stop-starting 02:15.
+identify: $(ENAMEL)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m studies.identify.identify $(IDENTIFY_ARGS)
 
 bench-paper: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)

@@ -39,7 +39,8 @@ class Frame:
     iface_damage: np.ndarray    # 1 - secant stiffness / k
     beam_broken: np.ndarray     # 1 = rod element deleted
     node_displacement: np.ndarray  # (nodes, 6): ux uy uz rx ry rz, d and rad
-    beam_stress: np.ndarray     # (beams,), sigma0: the solver's brittle-check stress (0 for deleted elements)
+    beam_stress: np.ndarray | None  # (beams,), sigma0: the solver's brittle-check stress (0 for deleted elements);
+    #                                 None in files of solvers before 2026-12-02, which did not write it
 
 
 @dataclasses.dataclass
@@ -128,7 +129,7 @@ def read_frames(frames_group) -> list[Frame]:
         out.append(Frame(index=int(name), target_da=float(a["target_da_over_d"]), da=float(a["da_over_d"]),
                          step=int(a["step"]), iface_state=fg["iface_state"][:], iface_damage=fg["iface_damage"][:],
                          beam_broken=fg["beam_broken"][:], node_displacement=fg["node_displacement"][:],
-                         beam_stress=fg["beam_stress"][:]))
+                         beam_stress=fg["beam_stress"][:] if "beam_stress" in fg else None))
     return out
 
 
