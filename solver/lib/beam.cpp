@@ -174,13 +174,19 @@ Vec12 localEndForces(const Section& s, double L, const Mat3& R, const Vec12& uGl
 
 // sigma_end = N/A + sqrt((My c/Iy)^2 + (Mz c/Iz)^2), N = f_local[6] (= -f_local[0] by equilibrium),
 // max over the two ends (the moment is linear along the element, so its extremes sit at the ends).
-double maxTensileStress(const Section& s, const Vec12& fLocal) {
-  const double axial = fLocal[6] / s.A;
+double maxTensileStressOfRows(const Section& s, const Vec5& f) {
+  const double axial = f[2] / s.A;
   // sqrt(a^2 + b^2) rather than std::hypot: no overflow is possible at these magnitudes, and it is 5x cheaper
   auto norm2 = [](double a, double b) { return std::sqrt(a * a + b * b); };
-  const double bendA = norm2(fLocal[4] * s.c / s.Iy, fLocal[5] * s.c / s.Iz);
-  const double bendB = norm2(fLocal[10] * s.c / s.Iy, fLocal[11] * s.c / s.Iz);
+  const double bendA = norm2(f[0] * s.c / s.Iy, f[1] * s.c / s.Iz);
+  const double bendB = norm2(f[3] * s.c / s.Iy, f[4] * s.c / s.Iz);
   return axial + std::max(bendA, bendB);
+}
+
+double maxTensileStress(const Section& s, const Vec12& fLocal) {
+  Vec5 f;
+  for (int r = 0; r < 5; ++r) f[r] = fLocal[kStressRows[r]];
+  return maxTensileStressOfRows(s, f);
 }
 
 // K phi = omega^2 M phi, ascending; negative round-off eigenvalues (rigid-body modes) clamped to 0.

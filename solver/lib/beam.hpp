@@ -66,6 +66,13 @@ Vec12 localEndForces(const Section& s, double L, const Mat3& R, const Vec12& uGl
 // end moments (My, Mz) = f_local[4,5] at node a and f_local[10,11] at node b.
 double maxTensileStress(const Section& s, const Vec12& fLocal);
 
+// The local end forces the stress check reads (the rest never enter it): axial force at end B and the two
+// bending moments at each end, fLocal[kStressRows[r]]; so the check needs 5 rows of K_local T, not 12.
+inline constexpr int kStressRows[5] = {4, 5, 6, 10, 11};
+using Vec5 = Eigen::Matrix<double, 5, 1>;
+// maxTensileStress of the end forces fLocal[kStressRows] (the code the solver runs; the Vec12 form calls it).
+double maxTensileStressOfRows(const Section& s, const Vec5& f);
+
 // Free-free element eigenfrequencies omega (rad per unit time) of K phi = omega^2 M phi, ascending;
 // the six rigid-body zeros come out as round-off and are clamped at 0. M must be positive definite
 // (throws std::invalid_argument otherwise, e.g. lumped mass with rotaryScale = 0).

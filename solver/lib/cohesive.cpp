@@ -110,7 +110,8 @@ Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const 
                               const Vec3& uB, const Vec3& thB, double& lambdaMax) {
   const Vec3 openingLocal = g.frame * computeOpening(g, uA, thA, uB, thB);
   const Vec3 tLocal = computeTraction(law, openingLocal, lambdaMax);
-  return -g.area * (g.frame.transpose() * tLocal);
+  const Vec3 tGlobal = g.frame.transpose() * tLocal;  // evaluated first: Eigen would fold -area into the product
+  return -g.area * tGlobal;
 }
 
 // B: (F_B, rB x F_B);  A: F_A = -F_B, (F_A, rA x F_A)
@@ -118,6 +119,35 @@ Wrench wrenchOnSide(const InterfaceGeometry& g, const Vec3& forceOnB, bool sideB
   if (sideB) return Wrench{forceOnB, g.armB.cross(forceOnB)};
   const Vec3 forceA = -forceOnB;
   return Wrench{forceA, g.armA.cross(forceA)};
+}
+
+SliceInterface packInSlice(const InterfaceGeometry& g) {
+  const Vec3 n = g.frame.row(0).transpose();
+  if (n.x() != 0.0 || g.armA.x() != 0.0 || g.armB.x() != 0.0 ||
+      g.frame.row(1).transpose() != Vec3::UnitX() || g.frame.row(2).transpose() != n.cross(Vec3::UnitX()))
+    throw std::invalid_argument("interface geometry is not in one yz-slice (normal or arm with an x part)");
+  return SliceInterface{n.y(), n.z(), g.armA.y(), g.armA.z(), g.armB.y(), g.armB.z(), g.area};
+}
+
+// delta = (uB + thB x rB) - (uA + thA x rA) with r = (0, ry, rz): thB x rB = (thy rz - thz ry, -thx rz, thx ry);
+// local opening (n . delta, delta_x, t2 . delta) with t2 = (0, nz, -ny); F_B = -A (n t_n + e_x t_1 + t2 t_2).
+// Every product the general form multiplies by an exact zero is left out: the sums keep their order, so the
+// result is the general form's bit for bit (a zero product adds nothing exactly, without FMA contraction).
+Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA,
+                              const Vec3& uB, const Vec3& thB, double& lambdaMax) {
+  const double ox = (uB.x() + (thB.y() * g.armBz - thB.z() * g.armBy)) - (uA.x() + (thA.y() * g.armAz - thA.z() * g.armAy));
+  const double oy = (uB.y() + (-(thB.x() * g.armBz))) - (uA.y() + (-(thA.x() * g.armAz)));
+  const double oz = (uB.z() + thB.x() * g.armBy) - (uA.z() + thA.x() * g.armAy);
+  const Vec3 openingLocal(g.ny * oy + g.nz * oz, ox, g.nz * oy + (-g.ny) * oz);
+  const Vec3 t = computeTraction(law, openingLocal, lambdaMax);
+  return -g.area * Vec3(t(1), g.ny * t(0) + g.nz * t(2), g.nz * t(0) + (-g.ny) * t(2));
+}
+
+// B: (F_B, rB x F_B);  A: F_A = -F_B, (F_A, rA x F_A)
+Wrench wrenchOnSide(const SliceInterface& g, const Vec3& forceOnB, bool sideB) {
+  const Vec3 arm = sideB ? Vec3(0.0, g.armBy, g.armBz) : Vec3(0.0, g.armAy, g.armAz);
+  const Vec3 force = sideB ? forceOnB : Vec3(-forceOnB);
+  return Wrench{force, arm.cross(force)};
 }
 
 // F_B as above, then the wrench on each side

@@ -81,6 +81,28 @@ Vec3 computeInterfaceForceOnB(const Law& law, const InterfaceGeometry& g, const 
 // The wrench on one node from the force on B: on B (F_B, r_B x F_B), on A (F_A = -F_B, r_A x F_A).
 Wrench wrenchOnSide(const InterfaceGeometry& g, const Vec3& forceOnB, bool sideB);
 
+// The same interface in the compact form the force kernel reads (56 bytes instead of 128): both nodes lie in
+// one yz-slice, so the normal has no x part, the frame follows from it (n = (0, ny, nz), t1 = e_x,
+// t2 = n x e_x = (0, nz, -ny)) and both arms lie in the slice (no x part).
+struct SliceInterface {
+  double ny, nz;          // unit normal n = (0, ny, nz), from A towards B
+  double armAy, armAz;    // armA = (0, armAy, armAz)
+  double armBy, armBz;    // armB = (0, armBy, armBz)
+  double area;
+};
+
+// The compact form of an in-slice interface; throws std::invalid_argument when g is not one (a normal or an
+// arm with an x part, or a frame other than makeFrame's for that normal).
+SliceInterface packInSlice(const InterfaceGeometry& g);
+
+// computeInterfaceForceOnB for the compact form (the code the solver runs): the same opening, traction and
+// force, written out for the known zeros of the frame and the arms; equal to the general form bit for bit.
+Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA,
+                              const Vec3& uB, const Vec3& thB, double& lambdaMax);
+
+// wrenchOnSide for the compact form.
+Wrench wrenchOnSide(const SliceInterface& g, const Vec3& forceOnB, bool sideB);
+
 // Linearised (undamaged, elastic) interface stiffness 12x12 in the DOF order (uA, thA, uB, thB), k*area with
 // the rigid arms; used only to estimate frequencies / transverse modulus, never in the time loop.
 Eigen::Matrix<double, 12, 12> elasticStiffness(const Law& law, const InterfaceGeometry& g);

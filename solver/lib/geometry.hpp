@@ -60,12 +60,12 @@ struct Model {
   std::vector<int> rodIndex;         // j in y = yCrack + j s +/- (x - xCrisscross) tan(theta) (+/- d/4 at theta = 0)
   Vec3 rodDirection(int ply) const;  // unit axis of the rods of a ply
 
-  // --- nodes (6 DOF each: ux uy uz rx ry rz) ---
+  // --- nodes (6 DOF each: ux uy uz rx ry rz), numbered slice by slice ---
   std::vector<Vec3> X;               // reference positions, z in {0, t}
   std::vector<int> nodeRod, nodeSlice;
   std::vector<std::int8_t> nodePly;
 
-  // --- beam elements (rod segments between consecutive slices) ---
+  // --- beam elements (rod segments between consecutive slices), in the order of their first node ---
   std::vector<std::array<int, 2>> beamNodes;
   std::vector<int> beamRod;
   double beamLength = 0;             // h_e / cos(theta), the same for all beams

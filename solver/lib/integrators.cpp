@@ -1,5 +1,6 @@
 #include "integrators.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -94,7 +95,7 @@ class PaperIntegrator : public Integrator {
     advancePositions(s);
     advanceClock(s, dt_);
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
+    s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, fI_);
     computeForcesForBeams(ops, s);
     solveAccelerations(ops, s);
     advanceVelocities(ops, s);
@@ -106,7 +107,7 @@ class PaperIntegrator : public Integrator {
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
+    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, fI_);
     r_ = -fI_ - ops.K * s.q - dampB_ * (ops.K * s.v) - dampA_ * (ops.M * s.v);
     solveAccelerations(ops, s);
   }
@@ -199,7 +200,6 @@ class PaperIntegrator : public Integrator {
   Eigen::UmfPackLU<SpMat> lu_;
   SpMat Hfp_, Mp_, Kp_;
   VecX w_, fI_, Kq_, Kw_, Mw_, r_, rf_, af_, aGrip_, vGrip_;
-  std::vector<cohesive::Vec3> forceOnB_;
 };
 
 // Rotary-inertia scale for the lumped element (DESIGN section 4): with physical rotary inertia the short
@@ -227,19 +227,27 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
                         const VecX& invMass) {
   const int n = static_cast<int>(invMass.size());
   VecX x = VecX::Zero(n), f(n), y(n);
-  std::uint64_t seed = 12345;  // fixed start vector: the estimate is deterministic
-  for (int dof : ops.freeDofs) {
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    x[dof] = static_cast<double>(seed >> 11) / 9007199254740992.0 - 0.5;
-  }
+  // A fixed start vector, drawn node by node along each rod (rod by rod), so that neither the estimate nor
+  // the time step depends on how the model numbers its nodes.
+  std::vector<int> alongRods(m.numNodes());
+  for (int i = 0; i < m.numNodes(); ++i) alongRods[i] = i;
+  std::sort(alongRods.begin(), alongRods.end(), [&](int a, int b) {
+    return std::make_pair(m.nodeRod[a], m.nodeSlice[a]) < std::make_pair(m.nodeRod[b], m.nodeSlice[b]);
+  });
+  std::uint64_t seed = 12345;
+  for (int node : alongRods)
+    for (int dof = 6 * node; dof < 6 * node + 6; ++dof) {
+      if (ops.dofToFree[dof] < 0) continue;
+      seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+      x[dof] = static_cast<double>(seed >> 11) / 9007199254740992.0 - 0.5;
+    }
   // the case's delta0 (not the law's: unbreakable interfaces have an infinite one)
   const double amplitude = 1e-3 * p.sigma0() / p.k();
   std::vector<double> lambdaMax(m.numInterfaces(), 0.0);  // undamaged
-  std::vector<cohesive::Vec3> forceOnB;
   double lambda = 0;
   for (int it = 0; it < 300; ++it) {
     x *= amplitude / x.cwiseAbs().maxCoeff();
-    computeForcesForInterfaces(m, law, ops, x, lambdaMax, false, forceOnB, f);
+    computeForcesForInterfaces(m, law, ops, x, lambdaMax, false, f);
     y = invMass.cwiseProduct(ops.K * x + f);
     for (int dof : ops.prescribedDofs) y[dof] = 0;
     const double next = x.dot(y.cwiseQuotient(invMass)) / x.dot(x.cwiseQuotient(invMass));
@@ -299,28 +307,22 @@ NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
   return B;
 }
 
-// y1 = K x1 and y2 = K x2 in one pass over K (the matrix is read once for both products). Rows are
-// independent and each row sums its entries in ascending column order, as a compressed-row product would,
-// so the result is the same bit for bit and does not depend on the thread count.
-void multiplyTwo(const NodeBlockMatrix& K, const VecX& x1, const VecX& x2, VecX& y1, VecX& y2) {
-  y1.resize(6 * K.blockRows);
-  y2.resize(6 * K.blockRows);
-#pragma omp parallel for schedule(static)
-  for (int R = 0; R < K.blockRows; ++R) {
-    // column by column, each row's sum in ascending column order (never a partial product added at once)
-    Vec6 s1 = Vec6::Zero(), s2 = Vec6::Zero();
-    for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
-      const Eigen::Map<const Mat6> block(K.values.data() + 36 * static_cast<std::size_t>(K.valueOf[b]));
-      const double* a1 = x1.data() + 6 * K.column[b];
-      const double* a2 = x2.data() + 6 * K.column[b];
-      for (int j = 0; j < 6; ++j) {
-        s1 += block.col(j) * a1[j];
-        s2 += block.col(j) * a2[j];
-      }
+// Block row R of K times x1 and x2, (K x1)_R and (K x2)_R, in one pass over the row (the matrix is read once
+// for both products). Each row sums its entries in ascending column order, as a compressed-row product
+// would, so the result is the same bit for bit, whichever thread computes it.
+inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1, Vec6& y2) {
+  Vec6 s1 = Vec6::Zero(), s2 = Vec6::Zero();
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+    const Eigen::Map<const Mat6> block(K.values.data() + 36 * static_cast<std::size_t>(K.valueOf[b]));
+    const double* a1 = x1 + 6 * K.column[b];
+    const double* a2 = x2 + 6 * K.column[b];
+    for (int j = 0; j < 6; ++j) {
+      s1 += block.col(j) * a1[j];
+      s2 += block.col(j) * a2[j];
     }
-    y1.segment<6>(6 * R) = s1;
-    y2.segment<6>(6 * R) = s2;
   }
+  y1 = s1;
+  y2 = s2;
 }
 
 // Fast scheme `lumped` (ours, DESIGN section 4): explicit central differences with a diagonal mass.
@@ -361,6 +363,9 @@ class LumpedIntegrator : public Integrator {
     for (int i = 0; i < mass_.size(); ++i)
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();
+    gripOfDof_.assign(m.numDofs(), -1);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) gripOfDof_[ops.prescribedDofs[i]] = static_cast<int>(i);
+    gripResidual_ = VecX::Zero(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
     omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
     bEff_ = std::min(mat.dampB, p.damping_cap / omegaMax_);
     dt_ = p.dt_factor * 2.0 * M_PI / omegaMax_;
@@ -390,11 +395,8 @@ class LumpedIntegrator : public Integrator {
   }
 
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
-    computeForcesForBeams(s);
     gatherGrips(ops, s.vHalf, vGripBefore_);  // v_{n-1/2} of the grips, for their reactions
-    advanceVelocities(s);
-    prescribeVelocities(ops, mat.loading.velocity(s.time + 0.5 * dt_), s.vHalf);
+    s.failedInterfaces = computeForcesAndAdvanceVelocities(m, mat, ops, s);
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
@@ -405,7 +407,7 @@ class LumpedIntegrator : public Integrator {
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     applyBoundaryConditions(ops, mat.loading, s.time, s);
-    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
+    computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, fI_);
     const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
     s.vHalf = s.v;
     for (int dof : ops.freeDofs) s.vHalf[dof] -= 0.5 * dt_ * acc[dof];
@@ -421,14 +423,63 @@ class LumpedIntegrator : public Integrator {
   }
 
  private:
-  // K q_n and K v_{n-1/2} in one pass over K
-  void computeForcesForBeams(const State& s) { multiplyTwo(Kblocks_, s.q, s.vHalf, Kq_, Kv_); }
-
-  // v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 (K q_n + f_iface + b' K v_{n-1/2})] / (1 + a dt/2)
-  void advanceVelocities(State& s) const {
-    const double a = dampA_, dt = dt_;
-    s.vHalf = ((1.0 - 0.5 * a * dt) * s.vHalf - dt * invMass_.cwiseProduct(Kq_ + fI_ + bEff_ * Kv_)) /
-              (1.0 + 0.5 * a * dt);
+  // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a
+  // slice in a fixed order, so nothing depends on the thread count). Per slice:
+  //   f_iface of its interfaces (opening, law, force on B; their history updated at q_n)
+  //   per node: the interfaces' wrench, K q_n and K v_{n-1/2} (its block row), r = K q + f_iface + b' K v,
+  //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
+  //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
+  //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
+  // v_{n+1/2} goes to vNext_ (K v_{n-1/2} of the next slice still reads v_{n-1/2}) and replaces v at the end.
+  // Returns the number of failed interfaces.
+  [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
+    const cohesive::Law law = mat.law;
+    const double a = dampA_, dt = dt_, b = bEff_, keep = 1.0 - 0.5 * a * dt, scale = 1.0 + 0.5 * a * dt;
+    const double Vgrip = mat.loading.velocity(s.time + 0.5 * dt_);
+    vNext_.resize(s.vHalf.size());
+    sliceWorkM_.assign(m.numSlices, 0.0);
+    sliceWorkK_.assign(m.numSlices, 0.0);
+    const double* q = s.q.data();
+    const double* v = s.vHalf.data();
+    double* vNext = vNext_.data();
+    double* lambda = s.lambdaMax.data();
+    const NodeBlockMatrix& K = Kblocks_;
+    int failed = 0;
+#pragma omp parallel reduction(+ : failed) firstprivate(law, q, v, vNext, lambda)
+    {
+      std::vector<cohesive::Vec3> onB(ops.maxIfacesPerSlice);
+#pragma omp for schedule(static)
+      for (int k = 0; k < m.numSlices; ++k) {
+        failed += computeForcesForInterfacesOfSlice(m, law, ops, k, s.q, lambda, true, onB.data());
+        double workM = 0, workK = 0;
+        for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
+          Vec3 F, Mo;
+          gatherInterfaceWrench(ops, node, onB.data(), ops.sliceIfaceStart[k], F, Mo);
+          Vec6 fI;
+          fI << -F, -Mo;
+          Vec6 Kq, Kv;
+          multiplyBlockRow(K, node, q, v, Kq, Kv);
+          for (int j = 0; j < 6; ++j) {
+            const int dof = 6 * node + j;
+            const double r = Kq[j] + fI[j] + b * Kv[j];
+            const int grip = gripOfDof_[dof];
+            double vn;
+            if (grip < 0) {
+              vn = (keep * v[dof] - dt * (invMass_[dof] * r)) / scale;
+            } else {
+              vn = ops.prescribedShape[grip] * Vgrip;
+              gripResidual_[grip] = r;
+            }
+            vNext[dof] = vn;
+            workM += vn * (mass_[dof] * vn);
+            workK += vn * Kv[j];
+          }
+        }
+        sliceWorkM_[k] = workM;
+        sliceWorkK_[k] = workK;
+      }
+    }
+    return failed;
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
@@ -437,24 +488,35 @@ class LumpedIntegrator : public Integrator {
     vGrip_.resize(vGripBefore_.size());
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
       const int dof = ops.prescribedDofs[i];
-      const double acc = (s.vHalf[dof] - vGripBefore_[i]) / dt_, vel = 0.5 * (s.vHalf[dof] + vGripBefore_[i]);
-      s.reaction[i] = Kq_[dof] + fI_[dof] + bEff_ * Kv_[dof] + mass_[dof] * (acc + dampA_ * vel);
+      const double acc = (vNext_[dof] - vGripBefore_[i]) / dt_, vel = 0.5 * (vNext_[dof] + vGripBefore_[i]);
+      s.reaction[i] = gripResidual_[i] + mass_[dof] * (acc + dampA_ * vel);
       vGrip_[i] = vel;
     }
   }
 
-  // W_damp += dt (a v_{n+1/2} . M v_{n+1/2} + b' v_{n+1/2} . K v_{n-1/2})
+  // W_damp += dt (a v_{n+1/2} . M v_{n+1/2} + b' v_{n+1/2} . K v_{n-1/2}), the sums in slice order
   void addDampingWork(State& s) const {
-    s.dampingWork += dt_ * (dampA_ * s.vHalf.dot(mass_.cwiseProduct(s.vHalf)) + bEff_ * s.vHalf.dot(Kv_));
+    double sumM = 0, sumK = 0;
+    for (std::size_t k = 0; k < sliceWorkM_.size(); ++k) { sumM += sliceWorkM_[k]; sumK += sliceWorkK_[k]; }
+    s.dampingWork += dt_ * (dampA_ * sumM + bEff_ * sumK);
   }
 
-  // q_{n+1} = q_n + dt v_{n+1/2}
-  void advancePositions(State& s) const { s.q += dt_ * s.vHalf; }
+  // v_{n+1/2} replaces v_{n-1/2};  q_{n+1} = q_n + dt v_{n+1/2}
+  void advancePositions(State& s) {
+    s.vHalf.swap(vNext_);
+    double* q = s.q.data();
+    const double* v = s.vHalf.data();
+    const double dt = dt_;
+    const Eigen::Index n = s.q.size();
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index i = 0; i < n; ++i) q[i] += dt * v[i];
+  }
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
-  VecX mass_, invMass_, fI_, Kq_, Kv_, vGripBefore_, vGrip_;
+  VecX mass_, invMass_, fI_, vNext_, vGripBefore_, vGrip_, gripResidual_;
+  std::vector<int> gripOfDof_;                 // index into ops.prescribedDofs; -1 for a free DOF
+  std::vector<double> sliceWorkM_, sliceWorkK_;  // each slice's share of the damping work's two sums
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
-  std::vector<cohesive::Vec3> forceOnB_;
 };
 
 }  // namespace

@@ -44,52 +44,71 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
 }
 
 // --- interfaces ----------------------------------------------------------------------------------------
-// f_iface = -(forces exerted on the nodes): per interface F_B (in parallel), then per node the sum over its
-// interface ends in the fixed CSR order of the wrench on that side.
+[[gnu::flatten]] int computeForcesForInterfacesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k, const VecX& q,
+                                      double* lambdaMax, bool update, cohesive::Vec3* onB) {
+  int failed = 0;
+  const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1];
+  const auto* nodes = m.ifaceNodes.data();
+  for (int i = first; i < last; ++i) {
+    const int A = nodes[i][0], B = nodes[i][1];
+    double lm = lambdaMax[i];
+    onB[i - first] = cohesive::computeInterfaceForceOnB(law, ops.ifacePacked[i], q.segment<3>(6 * A),
+                                                        q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
+                                                        q.segment<3>(6 * B + 3), lm);
+    if (update) lambdaMax[i] = lm;
+    failed += cohesive::isFailed(law, lm);
+  }
+  return failed;
+}
+
+[[gnu::flatten]] void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
+                           Vec3& moment) {
+  force.setZero();
+  moment.setZero();
+  for (int k = ops.nodeIfaceStart[node]; k < ops.nodeIfaceStart[node + 1]; ++k) {
+    const int i = ops.nodeIfaceList[k] >> 1;
+    const cohesive::Wrench w = cohesive::wrenchOnSide(ops.ifacePacked[i], onB[i - firstIface], ops.nodeIfaceList[k] & 1);
+    force += w.force;
+    moment += w.moment;
+  }
+}
+
+// f_iface = -(forces exerted on the nodes), slice by slice: F_B of the slice's interfaces into a buffer of the
+// thread, then per node of the slice the sum over its interface ends of the wrench on that side.
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
-                               std::vector<double>& lambdaMax, bool update, std::vector<cohesive::Vec3>& forceOnB,
-                               VecX& f) {
-  const int ni = m.numInterfaces();
-  forceOnB.resize(ni);
+                               std::vector<double>& lambdaMax, bool update, VecX& f) {
   f.resize(m.numDofs());
   // Private to each thread, so that they stay in registers (Eigen's vector stores may alias anything: shared
-  // pointers are reloaded after every interface): the law, and where the histories and forces go.
+  // pointers are reloaded after every interface): the law, and where the histories go.
   const cohesive::Law lawHere = law;
   double* lambda = lambdaMax.data();
-  cohesive::Vec3* onB = forceOnB.data();
   int failed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : failed) firstprivate(lawHere, lambda, onB)
-  for (int i = 0; i < ni; ++i) {
-    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-    double lm = lambda[i];
-    onB[i] = cohesive::computeInterfaceForceOnB(lawHere, m.ifaceGeom[i], q.segment<3>(6 * A), q.segment<3>(6 * A + 3),
-                                                q.segment<3>(6 * B), q.segment<3>(6 * B + 3), lm);
-    if (update) lambda[i] = lm;
-    failed += cohesive::isFailed(lawHere, lm);
-  }
-#pragma omp parallel for schedule(static)
-  for (int node = 0; node < m.numNodes(); ++node) {
-    Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
-    for (int k = ops.nodeIfaceStart[node]; k < ops.nodeIfaceStart[node + 1]; ++k) {
-      const int i = ops.nodeIfaceList[k] >> 1;
-      const cohesive::Wrench w = cohesive::wrenchOnSide(m.ifaceGeom[i], forceOnB[i], ops.nodeIfaceList[k] & 1);
-      F += w.force;
-      Mo += w.moment;
+#pragma omp parallel reduction(+ : failed) firstprivate(lawHere, lambda)
+  {
+    std::vector<cohesive::Vec3> onB(ops.maxIfacesPerSlice);
+#pragma omp for schedule(static)
+    for (int k = 0; k < m.numSlices; ++k) {
+      failed += computeForcesForInterfacesOfSlice(m, lawHere, ops, k, q, lambda, update, onB.data());
+      for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
+        Vec3 F, Mo;
+        gatherInterfaceWrench(ops, node, onB.data(), ops.sliceIfaceStart[k], F, Mo);
+        f.segment<3>(6 * node) = -F;
+        f.segment<3>(6 * node + 3) = -Mo;
+      }
     }
-    f.segment<3>(6 * node) = -F;
-    f.segment<3>(6 * node + 3) = -Mo;
   }
   return failed;
 }
 
 // --- rod elements --------------------------------------------------------------------------------------
 namespace {
-// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e. Always inlined: the deletion check
-// below runs it for every rod element at every step (a call costs ~20% of that loop).
+// sigma = max tensile stress of the local end forces f_l = (K_local T) u_e, of which only the rows
+// beam::kStressRows enter. Always inlined: the deletion check below runs it for every rod element at every
+// step (a call costs ~20% of that loop).
 [[gnu::always_inline]] inline double stressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
-  const beam::Vec12 fl = mat.beamLocalForceOperator[m.rodPly[m.beamRod[e]]] *
-                         gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
-  return beam::maxTensileStress(mat.section, fl);
+  const beam::Vec5 fl = mat.beamStressOperator[m.rodPly[m.beamRod[e]]].lazyProduct(
+      gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]));
+  return beam::maxTensileStressOfRows(mat.section, fl);
 }
 }  // namespace
 
@@ -99,12 +118,9 @@ double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, 
 
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                  const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio) {
-  ratio.assign(m.numBeams(), 0.0);
+  ratio.resize(m.numBeams());
 #pragma omp parallel for schedule(static)
-  for (int e = 0; e < m.numBeams(); ++e) {
-    if (beamBroken[e]) continue;
-    ratio[e] = stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
-  }
+  for (int e = 0; e < m.numBeams(); ++e) ratio[e] = beamBroken[e] ? 0.0 : stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
 }
 
 namespace {

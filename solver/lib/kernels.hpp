@@ -17,15 +17,24 @@ void prescribeVelocities(const Operators& ops, double V, VecX& v);
 /// q, v and a of the prescribed DOFs at time t (U, U', U'').
 void applyBoundaryConditions(const Operators& ops, const Loading& loading, double t, State& s);
 
-/// f_iface (eq. 8): internal force vector of all interfaces for displacements q. Each interface's force on
-/// its node B (cohesive::computeInterfaceForceOnB) goes to forceOnB (scratch, resized); the nodal wrenches
-/// (cohesive::wrenchOnSide) are gathered per node in the fixed CSR order, so f does not depend on the thread
-/// count; f is resized to the DOFs. lambdaMax is updated only when `update` (a trial evaluation leaves the
-/// history untouched).
-/// Returns the number of failed interfaces (with the history as updated, or as it would be).
+/// The forces of the interfaces of slice k on their node B (cohesive::computeInterfaceForceOnB of the
+/// compact geometry), into onB[i - first interface of the slice]; lambdaMax is updated only when `update`.
+/// Returns the number of failed interfaces of the slice (with the history as updated, or as it would be).
+int computeForcesForInterfacesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k, const VecX& q,
+                                      double* lambdaMax, bool update, cohesive::Vec3* onB);
+
+/// The wrench (force, moment) that a node's interfaces exert on it, summed over its interface ends in the
+/// fixed CSR order (so it does not depend on the thread count); onB as computeForcesForInterfacesOfSlice left
+/// it for the node's slice, whose first interface is `firstIface`.
+void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
+                           Vec3& moment);
+
+/// f_iface (eq. 8): internal force vector of all interfaces for displacements q, slice by slice: the forces of
+/// a slice's interfaces (computeForcesForInterfacesOfSlice), then f = -(the wrench on each of its nodes)
+/// (gatherInterfaceWrench); f is resized to the DOFs. lambdaMax is updated only when `update` (a trial
+/// evaluation leaves the history untouched). Returns the number of failed interfaces.
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
-                               std::vector<double>& lambdaMax, bool update, std::vector<cohesive::Vec3>& forceOnB,
-                               VecX& f);
+                               std::vector<double>& lambdaMax, bool update, VecX& f);
 
 /// Largest tensile stress of rod element e (units of E_r): beam::maxTensileStress of its local end forces.
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e);

@@ -153,7 +153,18 @@ Simulation::Simulation(const CaseParams& p)
   const beam::Section& section = mat.section;
 
   // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
-  mat.beamStrength = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
+  // Strengths drawn rod by rod, along each rod from its first slice (the realisation of a seed does not
+  // depend on how the model numbers its rod elements).
+  {
+    const std::vector<double> draws = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
+    std::vector<int> alongRods(m.numBeams());
+    for (int e = 0; e < m.numBeams(); ++e) alongRods[e] = e;
+    std::sort(alongRods.begin(), alongRods.end(), [&](int a, int b) {
+      return std::make_pair(m.beamRod[a], m.beamNodes[a][0]) < std::make_pair(m.beamRod[b], m.beamNodes[b][0]);
+    });
+    mat.beamStrength.resize(m.numBeams());
+    for (int r = 0; r < m.numBeams(); ++r) mat.beamStrength[alongRods[r]] = draws[r];
+  }
   if (!p.rods_breakable) std::fill(mat.beamStrength.begin(), mat.beamStrength.end(), INFINITY);
 
   // Element matrices: all rods of a ply share one orientation, so one matrix per ply.
@@ -166,6 +177,8 @@ Simulation::Simulation(const CaseParams& p)
     beam::Mat12 T = beam::Mat12::Zero();
     for (int blk = 0; blk < 4; ++blk) T.block<3, 3>(3 * blk, 3 * blk) = R;
     mat.beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
+    mat.beamStressOperator.emplace_back();
+    for (int r = 0; r < 5; ++r) mat.beamStressOperator.back().row(r) = mat.beamLocalForceOperator.back().row(beam::kStressRows[r]);
   }
   // Rod elements cut by the pre-crack carry no stiffness but keep their material's mass, lumped at their
   // nodes (as a deleted element does), so a rod end isolated by the cut is not massless. Assembled from
@@ -217,6 +230,26 @@ Simulation::Simulation(const CaseParams& p)
   for (int i = 0; i < m.numInterfaces(); ++i) {
     ops.nodeIfaceList[fill[m.ifaceNodes[i][0]]++] = 2 * i;
     ops.nodeIfaceList[fill[m.ifaceNodes[i][1]]++] = 2 * i + 1;
+  }
+
+  // Slices: contiguous nodes and interfaces, each interface within its slice (what the kernels rely on).
+  ops.sliceNodeStart.assign(m.numSlices + 1, 0);
+  ops.sliceIfaceStart.assign(m.numSlices + 1, 0);
+  for (int i = 0; i < m.numNodes(); ++i) {
+    if (i > 0 && m.nodeSlice[i] < m.nodeSlice[i - 1]) throw SolverError("model: nodes not numbered slice by slice");
+    ++ops.sliceNodeStart[m.nodeSlice[i] + 1];
+  }
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    const int k = m.ifaceSlice[i];
+    if ((i > 0 && k < m.ifaceSlice[i - 1]) || m.nodeSlice[m.ifaceNodes[i][0]] != k || m.nodeSlice[m.ifaceNodes[i][1]] != k)
+      throw SolverError("model: interfaces not built slice by slice, or joining nodes of another slice");
+    ++ops.sliceIfaceStart[k + 1];
+    ops.ifacePacked.push_back(cohesive::packInSlice(m.ifaceGeom[i]));
+  }
+  for (int k = 0; k < m.numSlices; ++k) {
+    ops.maxIfacesPerSlice = std::max(ops.maxIfacesPerSlice, ops.sliceIfaceStart[k + 1]);
+    ops.sliceNodeStart[k + 1] += ops.sliceNodeStart[k];
+    ops.sliceIfaceStart[k + 1] += ops.sliceIfaceStart[k];
   }
 
   state.q = VecX::Zero(n);

@@ -42,6 +42,8 @@ struct Materials {
   // per ply (all rods of a ply share one orientation): K_local T (u_e -> local end forces), and the global
   // element stiffness, consistent mass and lumped mass
   std::vector<beam::Mat12> beamLocalForceOperator, beamK, beamMc, beamMl;
+  // per ply: the rows beam::kStressRows of beamLocalForceOperator, all that the stress check needs
+  std::vector<Eigen::Matrix<double, 5, 12, Eigen::RowMajor>> beamStressOperator;
   double omegaMaxElement = 0;        // largest beam-element frequency (consistent mass)
   double E_transverse = 0, c_d = 0;  // transverse modulus and wave speed
   double omegaMin = 0, dampA = 0, dampB = 0;  // Rayleigh: C = dampA M + dampB K
@@ -60,6 +62,12 @@ struct Operators {
   std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack
   // Interface adjacency (node -> interface ends) for a deterministic gather of interface forces.
   std::vector<int> nodeIfaceStart, nodeIfaceList;  // CSR; entries are 2*iface + side (0 = A, 1 = B)
+  // The slices (geometry.hpp numbers nodes slice by slice, and builds interfaces slice by slice): the nodes
+  // of slice k are sliceNodeStart[k] .. sliceNodeStart[k+1] - 1, its interfaces likewise; an interface joins
+  // two nodes of its own slice. The force kernels work slice by slice, on data that stays in cache.
+  std::vector<int> sliceNodeStart, sliceIfaceStart;
+  std::vector<cohesive::SliceInterface> ifacePacked;  // Model::ifaceGeom in the compact form the kernels read
+  int maxIfacesPerSlice = 0;
 };
 
 /// Everything that changes during a run (checkpointable: checkpoint.cpp lists every field once).

@@ -324,3 +324,37 @@ TEST(Cohesive, MakeLawRejectsBadParameters) {
   }
   EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7));
 }
+
+// The compact in-slice form (what the solver's kernel runs) against the general form, on random interfaces
+// of one yz-slice (normal and arms without an x part) and random openings across every branch of the law,
+// contact included: the force on B and the history agree bit for bit, and so do both wrenches.
+TEST(Cohesive, SliceInterfaceFormEqualsTheGeneralForm) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3 xA(0.7, u(rng), u(rng)), xB(0.7, u(rng) + 1.2, u(rng));
+    const Vec3 mid(0.7, 0.5 * (xA.y() + xB.y()) + 0.1 * u(rng), 0.5 * (xA.z() + xB.z()) + 0.1 * u(rng));
+    const InterfaceGeometry g{makeFrame(xB - xA), mid - xA, mid - xB, 0.3 * u01(rng) + 0.01};
+    const SliceInterface c = packInSlice(g);
+    const double s = 1.5 * kLaw.deltaf();
+    const Vec3 uA = randomVec(rng, s), thA = randomVec(rng, s), uB = randomVec(rng, s), thB = randomVec(rng, s);
+    double lmGeneral = u01(rng) * kLaw.deltaf(), lmSlice = lmGeneral;
+    const Vec3 fGeneral = computeInterfaceForceOnB(kLaw, g, uA, thA, uB, thB, lmGeneral);
+    const Vec3 fSlice = computeInterfaceForceOnB(kLaw, c, uA, thA, uB, thB, lmSlice);
+    ASSERT_EQ(lmSlice, lmGeneral) << "trial " << trial;
+    for (int side = 0; side < 2; ++side) {
+      const Wrench wg = wrenchOnSide(g, fGeneral, side), ws = wrenchOnSide(c, fSlice, side);
+      for (int j = 0; j < 3; ++j) {
+        ASSERT_EQ(ws.force[j], wg.force[j]) << "trial " << trial << " side " << side;
+        ASSERT_EQ(ws.moment[j], wg.moment[j]) << "trial " << trial << " side " << side;
+      }
+    }
+  }
+}
+
+TEST(Cohesive, PackInSliceRefusesAnInterfaceAcrossSlices) {
+  const Vec3 xA(0, 0, 0), xB(0.1, 1, 0), mid(0.05, 0.5, 0.2);
+  EXPECT_THROW(packInSlice(InterfaceGeometry{makeFrame(xB - xA), mid - xA, mid - xB, 0.1}), std::invalid_argument);
+  const Vec3 yB(0, 1, 0), off(0.3, 0.5, 0);  // an arm with an x part
+  EXPECT_THROW(packInSlice(InterfaceGeometry{makeFrame(yB - xA), off - xA, off - yB, 0.1}), std::invalid_argument);
+}

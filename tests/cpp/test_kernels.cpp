@@ -45,9 +45,8 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
   const cohesive::Law& law = sim.materials.law;
   const VecX q = pseudoRandomField(m.numDofs(), 3 * law.delta0());
   std::vector<double> lambdaMax(m.numInterfaces(), 0.0);
-  std::vector<cohesive::Vec3> scratch;
   VecX f(m.numDofs());
-  const int failed = computeForcesForInterfaces(m, law, sim.ops, q, lambdaMax, true, scratch, f);
+  const int failed = computeForcesForInterfaces(m, law, sim.ops, q, lambdaMax, true, f);
 
   VecX expected = VecX::Zero(m.numDofs());
   std::vector<double> lambdaExpected(m.numInterfaces(), 0.0);
@@ -71,7 +70,7 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
 
   // a trial evaluation (update = false) leaves the history as it was
   const std::vector<double> before = lambdaMax;
-  computeForcesForInterfaces(m, law, sim.ops, 2.0 * q, lambdaMax, false, scratch, f);
+  computeForcesForInterfaces(m, law, sim.ops, 2.0 * q, lambdaMax, false, f);
   EXPECT_EQ(lambdaMax, before);
 }
 
