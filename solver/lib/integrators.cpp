@@ -12,6 +12,7 @@
 #include <Eigen/UmfPackSupport>
 
 #include "kernels.hpp"
+#include "loading_rate.hpp"
 
 namespace enamel {
 
@@ -31,10 +32,11 @@ SpMat selectRows(const SpMat& A, const std::vector<int>& rows) {
 }
 
 // --- pieces of a step that both schemes use -------------------------------------------------------------
-// t_{n+1} = t_n + dt, n + 1
-void advanceClock(State& s, double dt) {
+// t_{n+1} = t_n + dt, n + 1, and the loading clock tau_{n+1} (loading_rate.hpp)
+void advanceClock(const Loading& loading, State& s, double dt) {
   s.time += dt;
   ++s.step;
+  advanceLoadingClock(loading, dt, s);
 }
 
 // The prescribed DOFs' entries of a vector indexed by DOF.
@@ -92,8 +94,8 @@ class PaperIntegrator : public Integrator {
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     predictVelocities(s);
     advancePositions(s);
-    advanceClock(s, dt_);
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    advanceClock(mat.loading, s, dt_);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, forceOnB_, fI_);
     computeForcesForBeams(ops, s);
     solveAccelerations(ops, s);
@@ -105,7 +107,7 @@ class PaperIntegrator : public Integrator {
   }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
     r_ = -fI_ - ops.K * s.q - dampB_ * (ops.K * s.v) - dampA_ * (ops.M * s.v);
     solveAccelerations(ops, s);
@@ -394,22 +396,22 @@ class LumpedIntegrator : public Integrator {
     computeForcesForBeams(s);
     gatherGrips(ops, s.vHalf, vGripBefore_);  // v_{n-1/2} of the grips, for their reactions
     advanceVelocities(s);
-    prescribeVelocities(ops, mat.loading.velocity(s.time + 0.5 * dt_), s.vHalf);
+    prescribeVelocities(ops, computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_), s.vHalf);
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
     advancePositions(s);
-    advanceClock(s, dt_);
-    prescribeDisplacements(ops, mat.loading, s.time, s);
+    advanceClock(mat.loading, s, dt_);
+    prescribeDisplacements(ops, mat.loading, s);
   }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, forceOnB_, fI_);
     const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
     s.vHalf = s.v;
     for (int dof : ops.freeDofs) s.vHalf[dof] -= 0.5 * dt_ * acc[dof];
-    prescribeVelocities(ops, mat.loading.velocity(s.time - 0.5 * dt_), s.vHalf);
+    prescribeVelocities(ops, computeGripVelocity(mat.loading, s, -0.5 * dt_, dt_), s.vHalf);
   }
 
   void updateOperators(const Operators& ops) override {  // the lumped mass stays; only K changed
