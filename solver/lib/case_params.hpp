@@ -91,6 +91,13 @@ enum class Need { required, optional };
     X(rate_factor, Real, numerics, optional, 1, "(]", 0, 1e3, "", "-",                                              \
       "loading-rate multiplier: v_app = rate_factor x v_app_over_cd x c_d; the pipeline's half-rate "               \
       "twins (paper: 50% slower loading) use 0.5 on top of the preset's rate")                                      \
+    X(rate_adapt_max, Real, numerics, optional, 1, "[]", 1, 1000, "", "-",                                          \
+      "adaptive loading rate: the largest multiplier phi it may apply on top of v_app (1 = off); at each "         \
+      "history row, with rho = kinetic / strain energy (rods + interfaces), phi is halved (not below 1) when a "    \
+      "rod element was deleted in the interval or rho > 0.01, x1.25 (not above this) when rho < 0.0025 and no rod " \
+      "element was deleted and no more interfaces failed than 4 x the pre-cracked interfaces of one slice, else "   \
+      "held; phi "                                                                                                  \
+      "ramps linearly to its new value over the next history interval")                                            \
     X(ramp_transits, Real, numerics, optional, 1, "[]", 0, 1e3, "", "h_s/c_d",                                      \
       "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d")                             \
     X(zeta, Real, numerics, optional, 0.2, "[]", 0, 1, "", "-",                                                     \

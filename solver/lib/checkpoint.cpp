@@ -14,8 +14,8 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 3;  // 2: the header carries the build fingerprint; 3: State holds vHalf
-                                       // and the reactions, frames the rod stress
+constexpr std::uint32_t kVersion = 4;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+                                       // and the reactions, frames the rod stress; 4: the loading clock
 
 struct Writer {
   std::ofstream out;
@@ -84,6 +84,7 @@ struct Reader {
 template <class Io, class S, class R>
 void transferFields(Io& io, S& s, R& rec) {
   io.pod(s.step); io.pod(s.time); io.pod(s.appliedDisplacement);
+  io.pod(s.loadingTime); io.pod(s.rateMultiplier); io.pod(s.rateMultiplierTarget); io.pod(s.rateRampSteps);
   io.vec(s.q); io.vec(s.v); io.vec(s.a); io.vec(s.vHalf); io.vec(s.reaction);
   io.vec(s.lambdaMax); io.vec(s.beamBroken); io.vec(s.deletionOrder);
   io.pod(s.externalWork); io.pod(s.dampingWork); io.pod(s.rodFractureEnergy); io.pod(s.lastExternalPower);

@@ -13,6 +13,7 @@
 #include <Eigen/UmfPackSupport>
 
 #include "kernels.hpp"
+#include "loading_rate.hpp"
 
 namespace enamel {
 
@@ -32,10 +33,11 @@ SpMat selectRows(const SpMat& A, const std::vector<int>& rows) {
 }
 
 // --- pieces of a step that both schemes use -------------------------------------------------------------
-// t_{n+1} = t_n + dt, n + 1
-void advanceClock(State& s, double dt) {
+// t_{n+1} = t_n + dt, n + 1, and the loading clock tau_{n+1} (loading_rate.hpp)
+void advanceClock(const Loading& loading, State& s, double dt) {
   s.time += dt;
   ++s.step;
+  advanceLoadingClock(loading, dt, s);
 }
 
 // The prescribed DOFs' entries of a vector indexed by DOF.
@@ -93,8 +95,8 @@ class PaperIntegrator : public Integrator {
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     predictVelocities(s);
     advancePositions(s);
-    advanceClock(s, dt_);
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    advanceClock(mat.loading, s, dt_);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, fI_);
     computeForcesForBeams(ops, s);
     solveAccelerations(ops, s);
@@ -106,7 +108,7 @@ class PaperIntegrator : public Integrator {
   }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, fI_);
     r_ = -fI_ - ops.K * s.q - dampB_ * (ops.K * s.v) - dampA_ * (ops.M * s.v);
     solveAccelerations(ops, s);
@@ -401,17 +403,17 @@ class LumpedIntegrator : public Integrator {
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
     advancePositions(s);
-    advanceClock(s, dt_);
-    prescribeDisplacements(ops, mat.loading, s.time, s);
+    advanceClock(mat.loading, s, dt_);
+    prescribeDisplacements(ops, mat.loading, s);
   }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
-    applyBoundaryConditions(ops, mat.loading, s.time, s);
+    applyBoundaryConditions(ops, mat.loading, dt_, s);
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, fI_);
     const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
     s.vHalf = s.v;
     for (int dof : ops.freeDofs) s.vHalf[dof] -= 0.5 * dt_ * acc[dof];
-    prescribeVelocities(ops, mat.loading.velocity(s.time - 0.5 * dt_), s.vHalf);
+    prescribeVelocities(ops, computeGripVelocity(mat.loading, s, -0.5 * dt_, dt_), s.vHalf);
   }
 
   void updateOperators(const Operators& ops) override {  // the lumped mass stays; only K changed
@@ -435,7 +437,7 @@ class LumpedIntegrator : public Integrator {
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
     const cohesive::Law law = mat.law;
     const double a = dampA_, dt = dt_, b = bEff_, keep = 1.0 - 0.5 * a * dt, scale = 1.0 + 0.5 * a * dt;
-    const double Vgrip = mat.loading.velocity(s.time + 0.5 * dt_);
+    const double Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
     vNext_.resize(s.vHalf.size());
     sliceWorkM_.assign(m.numSlices, 0.0);
     sliceWorkK_.assign(m.numSlices, 0.0);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "loading_rate.hpp"
+
 namespace enamel {
 
 // --- loading -------------------------------------------------------------------------------------------
@@ -26,9 +28,9 @@ beam::Vec12 gatherElement(const VecX& q, int a, int b) {
   return u;
 }
 
-// --- prescribed DOFs: u_p = shape_p U(t) ------------------------------------------------------------------
-void prescribeDisplacements(const Operators& ops, const Loading& loading, double t, State& s) {
-  const double U = loading.displacement(t);
+// --- prescribed DOFs: u_p = shape_p U(tau), tau = t unless the rate is adaptive ---------------------------
+void prescribeDisplacements(const Operators& ops, const Loading& loading, State& s) {
+  const double U = loading.displacement(s.loadingTime);
   s.appliedDisplacement = U;
   for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) s.q[ops.prescribedDofs[i]] = ops.prescribedShape[i] * U;
 }
@@ -37,10 +39,22 @@ void prescribeVelocities(const Operators& ops, double V, VecX& v) {
   for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) v[ops.prescribedDofs[i]] = ops.prescribedShape[i] * V;
 }
 
-void applyBoundaryConditions(const Operators& ops, const Loading& loading, double t, State& s) {
-  prescribeDisplacements(ops, loading, t, s);
-  prescribeVelocities(ops, loading.velocity(t), s.v);
-  prescribeVelocities(ops, loading.acceleration(t), s.a);
+double computeGripVelocity(const Loading& loading, const State& s, double h, double dt) {
+  if (!loading.adaptive()) return loading.velocity(s.time + h);
+  const LoadingClock c = loadingClockAt(s, h, dt);
+  return c.phi * loading.velocity(c.tau);
+}
+
+void applyBoundaryConditions(const Operators& ops, const Loading& loading, double dt, State& s) {
+  prescribeDisplacements(ops, loading, s);
+  if (!loading.adaptive()) {
+    prescribeVelocities(ops, loading.velocity(s.time), s.v);
+    prescribeVelocities(ops, loading.acceleration(s.time), s.a);
+    return;
+  }
+  const LoadingClock c = loadingClockAt(s, 0.0, dt);
+  prescribeVelocities(ops, c.phi * loading.velocity(c.tau), s.v);
+  prescribeVelocities(ops, c.phi * c.phi * loading.acceleration(c.tau) + c.phiRate * loading.velocity(c.tau), s.a);
 }
 
 // --- interfaces ----------------------------------------------------------------------------------------

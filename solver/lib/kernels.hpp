@@ -10,12 +10,17 @@ namespace enamel {
 /// The 12 DOFs (uA, thA, uB, thB) of the element between nodes a and b.
 beam::Vec12 gatherElement(const VecX& q, int a, int b);
 
-/// u_p = shape_p U(t) at the prescribed DOFs, and s.appliedDisplacement = U(t).
-void prescribeDisplacements(const Operators& ops, const Loading& loading, double t, State& s);
+/// u_p = shape_p U(tau_n) at the prescribed DOFs, and s.appliedDisplacement = U(tau_n) (tau: the loading
+/// clock, s.loadingTime; = t_n when the rate is not adaptive).
+void prescribeDisplacements(const Operators& ops, const Loading& loading, State& s);
 /// v_p = shape_p V at the prescribed DOFs of a velocity vector v.
 void prescribeVelocities(const Operators& ops, double V, VecX& v);
-/// q, v and a of the prescribed DOFs at time t (U, U', U'').
-void applyBoundaryConditions(const Operators& ops, const Loading& loading, double t, State& s);
+/// The grips' velocity V at t_n + h: U'(t_n + h), or with an adaptive rate phi U'(tau) on the loading clock
+/// (loading_rate.hpp; dt is the step over which phi is linear).
+double computeGripVelocity(const Loading& loading, const State& s, double h, double dt);
+/// q, v and a of the prescribed DOFs at t_n: U, U', U'' of t_n, or with an adaptive rate U(tau),
+/// phi U'(tau), phi^2 U''(tau) + phi' U'(tau).
+void applyBoundaryConditions(const Operators& ops, const Loading& loading, double dt, State& s);
 
 /// The forces of the interfaces of slice k on their node B (cohesive::computeInterfaceForceOnB of the
 /// compact geometry), into onB[i - first interface of the slice]; lambdaMax is updated only when `update`.

@@ -70,6 +70,8 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"broken_rod_elements", &M::brokenBeams, "count"},
       {"failed_interfaces", &M::failedInterfaces, "count"},
       {"inelastic_interfaces", &M::inelasticInterfaces, "count"},
+      {"rate_multiplier", &M::rateMultiplier, "-",
+       "phi: the adaptive loading rate's multiplier of v_app (dU/dt = phi U'(tau); 1 when rate_adapt_max = 1)"},
   };
   return columns;
 }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "exit_codes.hpp"
+#include "loading_rate.hpp"
 
 namespace enamel {
 
@@ -76,7 +77,8 @@ class RunLoop {
       : sim_(sim), opt_(opt), p_(sim.params), start_(clock::now()), tty_(isatty(STDERR_FILENO)),
         frameTargets_(p_.frames_da_over_d),
         stopTargets_{p_.stop_da_over_d, p_.stop_u_over_d, double(p_.max_steps)},
-        minWork_(kBalanceMinWork * p_.Gamma() * sim.model.B), partialPath_(resultFileFor(opt.outDir, "running")) {
+        minWork_(kBalanceMinWork * p_.Gamma() * sim.model.B), burstInterfaces_(burstInterfacesOf(sim.model)),
+        partialPath_(resultFileFor(opt.outDir, "running")) {
     const double dt = sim.integrator->timeStep();
     historyEvery_ = p_.history_every > 0
         ? p_.history_every : std::max(1L, std::lround(0.05 * sim.model.h_s / sim.materials.c_d / dt));
@@ -160,6 +162,24 @@ class RunLoop {
     return true;
   }
 
+  /// The adaptive loading rate (loading_rate.hpp), at each history row when rate_adapt_max > 1: the rule
+  /// nextRateMultiplier on the interval since the previous row (energies at its end, rods deleted and interfaces
+  /// failed during it) sets phi's next target, reached linearly over the next history interval.
+  void controlLoadingRate() {
+    const auto& h = rec_.history;
+    if (!sim_.materials.loading.adaptive() || h.size() < 2) return;
+    const Measurement& now = h.back();
+    const Measurement& before = h[h.size() - 2];
+    RateControlInput in;
+    in.kinetic = now.kinetic;
+    in.strain = now.strainBeams + now.strainInterfaces;
+    in.rodsDeleted = now.brokenBeams - before.brokenBeams;
+    in.interfacesFailed = now.failedInterfaces - before.failedInterfaces;
+    in.burstInterfaces = burstInterfaces_;
+    State& s = sim_.state;
+    setRateMultiplierTarget(s, nextRateMultiplier(s.rateMultiplier, p_.rate_adapt_max, in), historyEvery_);
+  }
+
   /// A progress line on stderr every 2 s: step, load, crack, R, this piece's steps/s and the time left.
   void reportProgress(const Measurement& r) {
     const double w = wall();
@@ -169,9 +189,10 @@ class RunLoop {
     const ProgressSample now = sample();
     const double eta = estimateSecondsLeft(etaSince_, now, stopTargets_);
     const double rate = now.wall > pieceStart_.wall ? (now.step - pieceStart_.step) / (now.wall - pieceStart_.wall) : 0;
-    std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  %.1f steps/s  ETA %s%s",
+    std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  rate x%.3g  %.1f steps/s  ETA %s%s",
                  tty_ ? "\r" : "", s.step, s.time, now.displacement, s.crackAdvance, r.J / p_.Gamma(),
-                 s.brokenBeams(), rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?", tty_ ? "   " : "\n");
+                 s.brokenBeams(), s.rateMultiplier, rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?",
+                 tty_ ? "   " : "\n");
   }
 
   /// Rewrite the (partial) result file every writeIntervalSeconds.
@@ -254,6 +275,7 @@ class RunLoop {
   std::vector<double> frameTargets_;
   const StopTargets stopTargets_;
   const double minWork_;  // the balance error is checked once this much work was done
+  const int burstInterfaces_;  // the rate controller's burst: more interfaces failed in one interval
   const std::string partialPath_;  // the result file while the run is in progress
   long historyEvery_ = 1;
   RunRecord rec_;
@@ -275,6 +297,7 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
     if (run.historyDue()) {
       const Measurement r = run.recordHistory();
       if (!run.checkBalance(r)) break;
+      run.controlLoadingRate();
       run.reportProgress(r);
       run.saveIfDue();
     }

@@ -206,6 +206,7 @@ Simulation::Simulation(const CaseParams& p)
   mat.dampB = p.zeta / mat.omegaMin;
   mat.loading.vApp = p.rate_factor * p.v_app_over_cd * mat.c_d;
   mat.loading.rampTime = p.ramp_transits * m.h_s / mat.c_d;
+  mat.loading.rateAdaptMax = p.rate_adapt_max;
 
   // Prescribed DOFs: u_y of the top (+) and bottom (-) rows, graded 1 - x/w_s.
   ops.dofToFree.assign(n, 0);
@@ -503,6 +504,7 @@ Measurement Simulation::measure() const {
   r.step = state.step;
   r.time = state.time;
   r.appliedDisplacement = state.appliedDisplacement;
+  r.rateMultiplier = state.rateMultiplier;
   r.J = computeJ();
   r.crackAdvance = state.crackAdvance;
   r.kinetic = integrator->kineticEnergy(ops, state);

@@ -19,6 +19,7 @@ struct Measurement {
   double external = 0, balanceError = 0;
   int brokenBeams = 0, failedInterfaces = 0, inelasticInterfaces = 0;
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)
+  double rateMultiplier = 1;  // phi of the adaptive loading rate (loading_rate.hpp; 1 when off)
 };
 
 /// Worker threads the force loops use (set from the case key `threads` when a Simulation is built).

@@ -24,9 +24,12 @@ using SpMat = Eigen::SparseMatrix<double>;
 
 /// Graded velocity loading on the top and bottom boundary rows (DESIGN section 4):
 ///   u_y = +/- U(t) (1 - x / w_s),  U' = v_app r(t),  r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
+/// With an adaptive rate (rateAdaptMax > 1, loading_rate.hpp) the argument is the loading clock tau, not t.
 struct Loading {
   double vApp = 0;      // peak applied velocity at the cracked edge
   double rampTime = 0;  // T_r
+  double rateAdaptMax = 1;  // case key rate_adapt_max: the largest rate multiplier phi (1: off, tau = t)
+  bool adaptive() const { return rateAdaptMax > 1; }
   double displacement(double t) const;
   double velocity(double t) const;
   double acceleration(double t) const;
@@ -75,6 +78,11 @@ struct State {
   long step = 0;
   double time = 0;
   double appliedDisplacement = 0;      // U: u_y of the top row at the cracked edge
+  // loading clock (loading_rate.hpp): dtau/dt = phi; U = U(tau). Off: tau = t, phi = 1.
+  double loadingTime = 0;              // tau
+  double rateMultiplier = 1;           // phi at t_n
+  double rateMultiplierTarget = 1;     // the value phi ramps to, linearly ...
+  long rateRampSteps = 0;              // ... over this many more steps (0: no ramp, phi constant)
   VecX q;                              // displacements/rotations at t_n (6 per node)
   VecX v, a;                           // velocities and accelerations at t_n (`paper`; `lumped`: v is the
                                        // initial velocity `initialise` starts from, a unused)

@@ -1,0 +1,118 @@
+"""Adaptive loading rate (issue "Performance", item 2a; case key rate_adapt_max, solver/lib/loading_rate.hpp):
+a ci-size lumped run with rate_adapt_max = 8 raises the rate multiplier phi (/history/rate_multiplier) above 1
+while the specimen loads elastically, so the grips move faster than v_app on average; every history interval
+follows the rule (a rise x1.25 while elastic and rho = kinetic/strain < rho_lo, a halving after rho > rho_hi or a
+rod deletion); the run keeps its energy balance and its kinetic/strain ratio within the run's bounds (no
+warnings), and continues bit for bit after SIGKILLs and --restart. rate_adapt_max = 1 (the default) is today's
+run bit for bit: test_reference_outputs."""
+import signal
+import subprocess
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+CASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
+SETS = ["stop_da_over_d=2", "threads=1"]   # the ci preset stopped early: about 15 s
+KINETIC_WARN = 0.05                         # runner.cpp kKineticWarn
+RHO_HIGH, RHO_LOW, RAISE = 0.01, 0.0025, 1.25   # loading_rate.hpp
+
+
+def args_for(out, rate_max, *extra):
+    a = ["run", CASE, "--preset", "ci", "--out", out, "--quiet", "--set", f"rate_adapt_max={rate_max}"]
+    for s in SETS:
+        a += ["--set", s]
+    return a + list(extra)
+
+
+def read(path):
+    with h5py.File(path, "r") as f:
+        h = {k: f["history"][k][:] for k in f["history"]}
+        return {"history": h, "da": f["rcurve/da_over_d"][:], "R": f["rcurve/R_over_Gamma"][:],
+                "meta": dict(f["meta"].attrs)}
+
+
+@pytest.fixture(scope="module")
+def adaptive(run, tmp_path_factory):
+    out = tmp_path_factory.mktemp("rate8")
+    r = run(*args_for(out, 8))
+    assert r.returncode == 0, r.stderr
+    return read(out / "result.h5")
+
+
+def test_rate_rises_while_loading_elastically(adaptive):
+    h, meta = adaptive["history"], adaptive["meta"]
+    phi = h["rate_multiplier"]
+    assert np.all((phi >= 1.0) & (phi <= 8.0))
+    elastic = (h["da_over_d"] == 0) & (h["broken_rod_elements"] == 0) & (h["failed_interfaces"] == 0)
+    # on average faster than v_app: U(t) > 1.5 v_app t at the end (a fixed rate gives U < v_app t)
+    speedup = h["applied_displacement"][-1] / (float(meta["v_app"]) * h["time"][-1])
+    print(f"phi: max {phi.max():.3g}, while elastic {phi[elastic].max():.3g}; U / (v_app t) = {speedup:.3g}; "
+          f"steps {meta['steps']}")
+    assert phi[elastic].max() > 1.5, "the rate was not raised during the elastic loading"
+    assert speedup > 1.5
+
+
+def test_each_interval_follows_the_rule(adaptive):
+    """phi at row i+1 is the rule's target set at row i (the ramp ends on the next history row): x1.25 (capped)
+    while elastic and rho < rho_lo, halved (not below 1) after rho > rho_hi or a deletion."""
+    h = adaptive["history"]
+    phi = h["rate_multiplier"]
+    rho = h["kinetic_energy"] / np.maximum(h["strain_energy_beams"] + h["strain_energy_interfaces"], 1e-300)
+    deleted = np.diff(h["broken_rod_elements"], prepend=0) > 0
+    elastic = (h["da_over_d"] == 0) & (h["broken_rod_elements"] == 0) & (h["failed_interfaces"] == 0)
+    raised = lowered = 0
+    for i in range(1, len(phi) - 2):   # the last row is where the run stopped, off the history interval
+        if deleted[i] or rho[i] > RHO_HIGH:
+            assert phi[i + 1] == max(1.0, 0.5 * phi[i]), f"row {i}: not halved"
+            lowered += 1
+        elif elastic[i] and rho[i] < RHO_LOW:
+            assert phi[i + 1] == min(8.0, RAISE * phi[i]), f"row {i}: not raised"
+            raised += 1
+    assert raised >= 3 and lowered >= 1, (raised, lowered)
+
+
+def test_adaptive_run_stays_quasi_static_and_balanced(adaptive):
+    meta = adaptive["meta"]
+    assert meta["status"] == "completed"
+    assert meta["warnings"] == "", meta["warnings"]   # neither the energy balance nor the kinetic ratio warned
+    assert meta["max_kinetic_over_strain_while_growing"] < KINETIC_WARN
+
+
+def checkpoint_stamp(out):
+    try:
+        return (out / "checkpoint.bin").stat().st_mtime_ns
+    except FileNotFoundError:
+        return None
+
+
+def test_restart_of_adaptive_run_is_bit_for_bit(enamel, adaptive, tmp_path):
+    """Killed (SIGKILL) twice after a checkpoint while phi moves, continued with --restart: the same history
+    (phi included), R-curve and step count as the uninterrupted run."""
+    out = tmp_path / "killed"
+    kills = 0
+    for delay in (0.05, 0.3, None):
+        extra = ["--checkpoint-every", "0.1"] + (["--restart"] if kills else [])
+        before = checkpoint_stamp(out)
+        p = subprocess.Popen([str(enamel), *map(str, args_for(out, 8, *extra))], stderr=subprocess.PIPE, text=True)
+        if delay is not None:
+            while p.poll() is None and checkpoint_stamp(out) in (None, before):
+                time.sleep(0.005)
+            time.sleep(delay)
+            if p.poll() is None:
+                p.send_signal(signal.SIGKILL)
+                p.wait()
+                kills += 1
+                continue
+        _, err = p.communicate(timeout=600)
+        assert p.returncode == 0, err
+        break
+    assert kills == 2, f"only {kills} kills landed after a checkpoint (run too short?)"
+    a, b = adaptive, read(out / "result.h5")
+    assert a["meta"]["steps"] == b["meta"]["steps"]
+    assert np.array_equal(a["da"], b["da"]) and np.array_equal(a["R"], b["R"])
+    for name in ("rate_multiplier", "applied_displacement", "J_over_Gamma", "kinetic_energy", "broken_rod_elements"):
+        assert np.array_equal(a["history"][name], b["history"][name]), f"{name} differs after restarts"
