@@ -11,11 +11,14 @@ machine in the same state:
    error against the reference of the same case: R-curve relative L2 difference over the common Delta_a
    range, R_init and R_ss differences, broken rod elements. The runs share the cores two at a time
    (--jobs), the long reference runs first.
-2. Cost growth. Short runs (a fixed number of steps) of the theta_D = 30 case at growing specimen size and
+2. Kernel profile: `enamel-dem profile` on the `paper` preset's theta_D = 30 case (1.39 M DOF) with the
+   fastest lumped knobs, on 1 and on 2 threads: each kernel's time per step, the bytes it must move per step
+   and the bandwidth it achieves next to a triad measured in the same process (bench/profile.md).
+3. Cost growth. Short runs (a fixed number of steps) of the theta_D = 30 case at growing specimen size and
    finer slice spacing h_e, both integrators: wall time per step against DOF and h_e, and from it an estimate
    of the wall time of one whole run, up to the `paper` preset (200 d x 200 d).
 
-Writes bench/results.csv, bench/cost_growth.csv, bench/results.md (the README quotes them) and
+Writes bench/results.csv, bench/cost_growth.csv, bench/profile.md, bench/results.md (the README quotes them) and
 bench/out/pareto.{pdf,png}, bench/out/cost_growth.{pdf,png}. Runs go to runs/bench/.
 """
 import argparse
@@ -75,6 +78,28 @@ COST_SIZES = [(16, 8, 0.3), (24, 12, 0.3), (40, 20, 0.3), (80, 40, 0.3), (200, 2
               (40, 20, 0.2), (40, 20, 0.15)]
 COST_PAPER_MAX_DOF = 150_000   # the paper scheme's factorisation beyond this is left out (memory, minutes)
 COST_WORK = {"lumped": 3e8, "paper": 6e7}   # DOF x steps per cost run
+
+
+# Kernel profile: the paper preset's case with the fastest lumped knobs (what `make bench-paper` steps).
+PROFILE_CASE = CASES[0]
+PROFILE_SETS = {"integrator": '"lumped"', "dt_factor": 0.22, "damping_cap": 0.5}
+
+
+def profile_markdown(preset: str, threads_list=(1, 2), extra_sets: dict | None = None) -> str:
+    """`enamel-dem profile` of PROFILE_CASE at `preset`, once per thread count, as Markdown sections."""
+    out = []
+    for threads in threads_list:
+        sets = dict(PROFILE_SETS, threads=threads, **(extra_sets or {}))
+        args = [str(solver()), "profile", str(paths.PAPER_CASES / f"{PROFILE_CASE}.toml"), "--preset", preset]
+        for k, v in sets.items():
+            args += ["--set", f"{k}={v}"]
+        t0 = time.perf_counter()
+        proc = subprocess.run(args, capture_output=True, text=True)
+        if proc.returncode != 0:
+            out.append(f"### {threads} thread(s)\n\nprofile failed (exit {proc.returncode}): {proc.stderr.strip()}\n")
+            continue
+        out.append(f"### {threads} thread(s) ({time.perf_counter() - t0:.0f} s with set-up)\n\n{proc.stdout}")
+    return "\n".join(out)
 
 
 @dataclasses.dataclass
@@ -443,6 +468,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
     ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")
+    ap.add_argument("--profile-only", action="store_true",
+                    help="only the kernel profile (bench/profile.md): a few minutes")
     ap.add_argument("--replot", action="store_true",
                     help="run nothing: redraw the figures from OUT/results.csv and OUT/cost_growth.csv")
     a = ap.parse_args(argv)
@@ -460,10 +487,19 @@ def main(argv=None) -> int:
         cases = CASES[:1]
         sizes = [(8, 4, 0.3), (12, 6, 0.3)]
         extra = {"w_s_over_d": 8, "h_s_over_d": 4, "stop_da_over_d": 1}
-    if a.runs.exists():
-        shutil.rmtree(a.runs)
     t0 = time.perf_counter()
     date = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    a.out.mkdir(parents=True, exist_ok=True)
+    profile_preset, profile_extra = ("ci", {"w_s_over_d": 8, "h_s_over_d": 4}) if a.quick else ("paper", {})
+    profile_md = (f"# Kernel profile ({date}; {machine()}; `enamel-dem profile`, preset `{profile_preset}`, "
+                  f"{PROFILE_CASE}, lumped dt 0.22 cap 0.5)\n\n"
+                  + profile_markdown(profile_preset, extra_sets=profile_extra))
+    (a.out / "profile.md").write_text(profile_md)
+    print(a.out / "profile.md")
+    if a.profile_only:
+        return 0
+    if a.runs.exists():
+        shutil.rmtree(a.runs)
 
     jobs = speed_error_jobs(cases, variants, PRESET, a.runs, extra)
     run_jobs(jobs, a.jobs)
@@ -496,7 +532,7 @@ def main(argv=None) -> int:
     if crows:
         cost_figure(crows, a.out / "out", title)
     md = a.out / "results.md"
-    md.write_text(summary_markdown(rows, crows, header))
+    md.write_text(summary_markdown(rows, crows, header) + "\n" + profile_md.replace("# Kernel profile", "## Kernel profile", 1))
     print(md)
     bad = [r for r in rows if r.get("exit_code") != 0]
     for r in bad:

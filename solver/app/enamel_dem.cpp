@@ -16,6 +16,7 @@
 #include "exit_codes.hpp"
 #include "geometry.hpp"
 #include "integrators.hpp"
+#include "profile.hpp"
 #include "resources.hpp"
 #include "runner.hpp"
 #include "simulation.hpp"
@@ -89,6 +90,15 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   std::printf("loading            v_app %.4g d c_r/d, ramp %.4g d/c_r\n", mat.loading.vApp, mat.loading.rampTime);
   std::printf("memory estimate    %.0f MB (%s)\n", estimateResources(p).memoryBytes / 1048576,
               "enamel-dem info --estimate; a run refuses a case that needs more than is available");
+  return exit_code::ok;
+}
+
+// Time each kernel on the case's model (profile.hpp) and print the table; writes nothing else.
+int runProfile(const CaseArgs& args, long warmup, long steps) {
+  const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
+  if (int rc = checkMemory(p)) return rc;
+  Simulation sim(p);
+  std::printf("%s", formatProfileMarkdown(profileKernels(sim, warmup, steps)).c_str());
   return exit_code::ok;
 }
 
@@ -222,6 +232,15 @@ int main(int argc, char** argv) {
                   "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
 
+  CaseArgs profileArgs;
+  long profileWarmup = 200, profileSteps = 100;
+  CLI::App* profile = app.add_subcommand(
+      "profile", "time each kernel of the time step on the case's model (integrator lumped) and print a Markdown "
+                 "table: s/step, bytes moved per step, achieved GB/s next to a triad measured in the same run");
+  profileArgs.addTo(profile);
+  profile->add_option("--warmup", profileWarmup, "steps run before timing")->check(CLI::NonNegativeNumber);
+  profile->add_option("--steps", profileSteps, "steps timed per kernel")->check(CLI::PositiveNumber);
+
   CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
 
   try {
@@ -241,6 +260,7 @@ int main(int argc, char** argv) {
     if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
     if (*info) return runInfo(infoArgs, estimateOnly);
     if (*run) return runRun(runArgs, flags);
+    if (*profile) return runProfile(profileArgs, profileWarmup, profileSteps);
   } catch (const std::exception& e) {
     return fail(exitCodeOf(e), e.what());
   }

@@ -1,0 +1,130 @@
+#include "profile.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "kernels.hpp"
+
+namespace enamel {
+
+namespace {
+
+using clock = std::chrono::steady_clock;
+
+// Seconds per call of f, over `steps` calls.
+template <class F>
+double secondsPerCall(long steps, F&& f) {
+  const auto t0 = clock::now();
+  for (long i = 0; i < steps; ++i) f();
+  return std::chrono::duration<double>(clock::now() - t0).count() / std::max(1L, steps);
+}
+
+// a[i] = b[i] + s c[i] (STREAM's triad, 24 bytes per element) over vectors of at least 2^23 doubles (64 MB
+// each: far larger than any cache), the best of 10 passes, with this run's threads.
+double measureTriad(long n) {
+  n = std::max(n, 1L << 23);
+  std::vector<double> a(n), b(n, 1.0), c(n, 2.0);
+  const double s = 0.5;
+  double best = 1e30;
+  for (int pass = 0; pass < 10; ++pass) {
+    const auto t0 = clock::now();
+    double* pa = a.data();
+    const double* pb = b.data();
+    const double* pc = c.data();
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
+    best = std::min(best, std::chrono::duration<double>(clock::now() - t0).count());
+  }
+  return 24.0 * static_cast<double>(n) / best;
+}
+
+// The bytes a kernel must move per step: every array it touches counted once per step (what it would cost if
+// nothing stayed in cache between steps and everything within a slice did). 8 bytes per double, 4 per int.
+struct ByteCounts {
+  double interfaces, interfacesAlone, nodes, positions, stressCheck;
+};
+
+ByteCounts countBytes(const Simulation& sim) {
+  const Model& m = sim.model;
+  const double ni = m.numInterfaces(), nn = m.numNodes(), ne = m.numBeams();
+  const double ends = static_cast<double>(sim.ops.nodeIfaceList.size());
+  const double blocks = 2.0 * ne + nn;  // K: one diagonal block per node, two off-diagonal per rod element
+  ByteCounts b;
+  // per interface: compact geometry (56), its two nodes (8), lambdaMax read and written (16)
+  b.interfaces = ni * (sizeof(cohesive::SliceInterface) + 8 + 16);
+  // the same on their own: also q read, f written and the CSR of interface ends
+  b.interfacesAlone = b.interfaces + nn * (48 + 48 + 4) + 4 * ends;
+  // per node: q and v_{n-1/2} read, v_{n+1/2} written, 1/m and m, the grip map (6 x (8 + 8 + 8 + 8 + 8 + 4));
+  // the interface ends' CSR (4 per end + 4 per node); K's blocks (column and value index, 8 per block + 4 per row)
+  b.nodes = nn * 6 * (8 * 5 + 4) + 4 * (ends + nn) + 8 * blocks + 4 * nn;
+  // q read and written, v read
+  b.positions = nn * 6 * 24;
+  // per rod element: its nodes (8), rod (4), strength (8), broken flag (1), ratio written (8), and one node's q
+  // (48: consecutive elements share the other)
+  b.stressCheck = ne * (8 + 4 + 8 + 1 + 8 + 48);
+  return b;
+}
+
+}  // namespace
+
+KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
+  if (sim.integrator->name() != "lumped")
+    throw IntegratorError("profile: integrator '" + sim.integrator->name() + "' is not profiled (allowed: lumped)");
+  KernelProfile p;
+  p.threads = threadCount();
+  p.steps = steps;
+  p.dof = sim.model.numDofs();
+  for (long i = 0; i < warmup; ++i) sim.step();
+  const ByteCounts bytes = countBytes(sim);
+  const Model& m = sim.model;
+  State& s = sim.state;
+  VecX f;
+  std::vector<double> ratio;
+  const double step = secondsPerCall(steps, [&] { sim.step(); });
+  const double advance = secondsPerCall(steps, [&] { sim.integrator->advance(m, sim.materials, sim.ops, s); });
+  const double interfaces = secondsPerCall(
+      steps, [&] { computeForcesForInterfaces(m, sim.materials.law, sim.ops, s.q, s.lambdaMax, false, f); });
+  const double check = secondsPerCall(
+      steps, [&] { computeStressRatiosForBeams(m, sim.materials, s.q, s.beamBroken, ratio); });
+  const double positions = secondsPerCall(steps, [&] { s.q += sim.integrator->timeStep() * s.vHalf; });
+  p.triadBytesPerSecond = measureTriad(3 * static_cast<long>(p.dof));
+  p.kernels = {
+      {"step", "the whole time step (integrator's advance, rod stress check, crack measure when something failed)",
+       step, bytes.interfaces + bytes.nodes + bytes.positions + bytes.stressCheck},
+      {"advance", "the integrator's step: the slice pass (interfaces, then nodes) and the position update",
+       advance, bytes.interfaces + bytes.nodes + bytes.positions},
+      {"  interfaces", "per interface: opening, law, force on B; per node its wrench (alone, with f written)",
+       interfaces, bytes.interfacesAlone},
+      {"  nodes", "advance - interfaces - positions: per node K rows, v_{n+1/2}, grip residuals, damping sums",
+       std::max(0.0, advance - interfaces - positions), bytes.nodes},
+      {"  positions", "q += dt v over all DOF", positions, bytes.positions},
+      {"stress check", "per rod element: 5 rows of K_local T u_e, sigma / sigma_ru", check, bytes.stressCheck},
+      {"rest", "step - advance - stress check (crack measure, deletions, bookkeeping)",
+       std::max(0.0, step - advance - check), 0},
+  };
+  return p;
+}
+
+std::string formatProfileMarkdown(const KernelProfile& p) {
+  std::ostringstream o;
+  char buf[512];
+  const double step = p.kernels.empty() ? 0 : p.kernels.front().secondsPerStep;
+  std::snprintf(buf, sizeof buf,
+                "%.0f DOF, %d thread(s), %ld steps per kernel: %.4g s/step, %.1f M DOF-updates/s per core; "
+                "triad %.1f GB/s\n\n",
+                p.dof, p.threads, p.steps, step, p.dof / step / p.threads / 1e6, p.triadBytesPerSecond / 1e9);
+  o << buf;
+  o << "| kernel | s/step | share of step | MB/step | GB/s | % of triad | what |\n|---|---|---|---|---|---|---|\n";
+  for (const KernelTiming& k : p.kernels) {
+    const double gbs = k.secondsPerStep > 0 ? k.bytesPerStep / k.secondsPerStep / 1e9 : 0;
+    std::snprintf(buf, sizeof buf, "| %s | %.4g | %.0f%% | %.1f | %.1f | %.0f%% | %s |\n", k.name.c_str(),
+                  k.secondsPerStep, step > 0 ? 100 * k.secondsPerStep / step : 0, k.bytesPerStep / 1e6, gbs,
+                  100 * gbs * 1e9 / p.triadBytesPerSecond, k.what.c_str());
+    o << buf;
+  }
+  return o.str();
+}
+
+}  // namespace enamel
