@@ -100,6 +100,10 @@ enum class Need { required, optional };
       "ramps linearly to its new value over the next history interval")                                            \
     X(ramp_transits, Real, numerics, optional, 1, "[]", 0, 1e3, "", "h_s/c_d",                                      \
       "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d")                             \
+    X(static_start, Real, numerics, optional, 0, "[)", 0, 1, "", "-",                                               \
+      "static elastic start: start from the static elastic solution at this fraction of the applied "               \
+      "displacement U_c at which the first interface reaches delta0 (or the first rod element its strength, "       \
+      "if earlier), moving at the quasi-static velocity of the loading; 0 = start from rest")                       \
     X(zeta, Real, numerics, optional, 0.2, "[]", 0, 1, "", "-",                                                     \
       "Rayleigh damping: damping ratio at w_min = pi c_d / h_s (C = a M + b K)")                                    \
     X(dt_factor, Real, numerics, optional, 0.1, "(]", 0, 1, "", "smallest element period",                          \

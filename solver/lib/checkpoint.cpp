@@ -15,7 +15,8 @@ namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
 constexpr std::uint32_t kVersion = 4;  // 2: the header carries the build fingerprint; 3: State holds vHalf
-                                       // and the reactions, frames the rod stress; 4: the loading clock
+                                       // and the reactions, frames the rod stress; 4: the loading clock and
+                                       // the record's static elastic start
 
 struct Writer {
   std::ofstream out;
@@ -100,6 +101,7 @@ void transferFields(Io& io, S& s, R& rec) {
   io.pod(rec.wallSeconds); io.pod(rec.steps); io.pod(rec.maxKineticRatio);
   io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic);
   io.items(rec.warnings, [&](auto& w) { io.str(w); });
+  io.pod(rec.staticStart);
 }
 
 // The effective case without its comment lines (the source file as given, the preset, the --set options): the

@@ -1,6 +1,7 @@
 #include "kernels.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "loading_rate.hpp"
 
@@ -19,6 +20,18 @@ double Loading::displacement(double t) const {
 double Loading::acceleration(double t) const {
   if (t >= rampTime) return 0.0;
   return vApp * 0.5 * M_PI / rampTime * std::sin(M_PI * t / rampTime);
+}
+
+double Loading::timeOfDisplacement(double U) const {
+  if (U <= 0) return 0.0;
+  if (rampTime <= 0) return U / vApp;
+  if (U >= displacement(rampTime)) return U / vApp + 0.5 * rampTime;  // U = v_app (t - T_r / 2)
+  double lo = 0, hi = rampTime;
+  for (int it = 0; it < 200 && hi - lo > 4 * std::numeric_limits<double>::epsilon() * rampTime; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (displacement(mid) < U ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 beam::Vec12 gatherElement(const VecX& q, int a, int b) {

@@ -238,6 +238,21 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "sigma0", p.sigma0());
       attr(g.id, "k", p.k());
       attr(g.id, "sigma_ru_mean", p.sigma_ru());
+      const StaticStart& st = rec.staticStart;
+      attr(g.id, "static_start", st.fraction);
+      attr(g.id, "static_start_description",
+           "static elastic start (case key static_start): the run started at t = static_start_time from the "
+           "static elastic solution at applied displacement static_start_U_over_d = static_start x "
+           "static_start_Uc_over_d, moving at the loading's quasi-static velocity; static_start_Uc_over_d is the "
+           "applied displacement at which the first interface reaches delta0 or the first rod element its "
+           "strength (static_start_limited_by), static_start_solve_s the wall time of the static solve. "
+           "static_start = 0: the run started from rest (U_c not computed: NaN)");
+      attr(g.id, "static_start_Uc_over_d", st.firstDamageDisplacement);
+      attr(g.id, "static_start_U_over_d", st.displacement);
+      attr(g.id, "static_start_time", st.time);
+      attr(g.id, "static_start_limited_by",
+           st.fraction > 0 ? (st.limitedByRod ? "rod element strength" : "interface delta0") : "");
+      attr(g.id, "static_start_solve_s", st.solveSeconds);
     }
     // --- /rcurve ---
     {

@@ -98,11 +98,25 @@ class RunLoop {
                    sim_.state.step, sim_.state.appliedDisplacement, sim_.state.crackAdvance,
                    formatDuration(rec_.wallSeconds).c_str());
     } else {
+      if (p_.static_start > 0) startFromStaticElastic();
       rec_.history.push_back(sim_.measure());
     }
     save();
     // Progress rates are measured over this piece of the run, and the crack's from where it started.
     pieceStart_ = etaSince_ = sample();
+  }
+
+  /// The static elastic start (case key static_start), timed, and a line on stderr saying what it did.
+  void startFromStaticElastic() {
+    const auto t0 = clock::now();
+    rec_.staticStart = sim_.startFromStaticElastic(p_.static_start);
+    StaticStart& st = rec_.staticStart;
+    st.solveSeconds = std::chrono::duration<double>(clock::now() - t0).count();
+    std::fprintf(stderr, "enamel-dem: static elastic start at U/d = %.6g, %g of the first-damage displacement "
+                         "U_c/d = %.6g (%s), t = %.6g: skipped ~%.0f steps; static solve %.1f s\n",
+                 st.displacement, st.fraction, st.firstDamageDisplacement,
+                 st.limitedByRod ? "a rod element's strength" : "an interface's delta0", st.time,
+                 st.time / sim_.integrator->timeStep(), st.solveSeconds);
   }
 
   /// Fault injection for the tests of the failure path (RunOptions::injectNanAtStep): a NaN in one free

@@ -296,6 +296,78 @@ void Simulation::solveStaticElastic(double U) {
   for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) state.reaction[i] = f[ops.prescribedDofs[i]];
 }
 
+// --- static elastic start -------------------------------------------------------------------------------
+double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const Operators& ops, const VecX& q1,
+                                      const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable,
+                                      bool& limitedByRod) {
+  double uc = INFINITY;
+  limitedByRod = false;
+  if (interfacesBreakable && m.numInterfaces() > 0) {
+    // lambda_i(q1): the history an undamaged interface takes at q1 (no interface is assembled or changed)
+    std::vector<double> lambda(m.numInterfaces(), 0.0);
+    VecX f;
+    computeForcesForInterfaces(m, mat.law, ops, q1, lambda, true, f);
+    const double worst = *std::max_element(lambda.begin(), lambda.end());
+    if (worst > 0) uc = mat.law.delta0() / worst;
+  }
+  if (mat.rodsBreakable && m.numBeams() > 0) {
+    std::vector<double> ratio;
+    computeStressRatiosForBeams(m, mat, q1, beamBroken, ratio);
+    const double worst = *std::max_element(ratio.begin(), ratio.end());
+    if (worst > 0 && 1.0 / worst < uc) {
+      uc = 1.0 / worst;
+      limitedByRod = true;
+    }
+  }
+  return uc;
+}
+
+namespace {
+
+// The quasi-static state of the loading at time t, U(t) = U: every DOF moves with the grips in proportion to
+// the static field q1 at unit displacement (q = U q1, v = U'(t) q1, a = U''(t) q1), the reactions are the
+// static ones U R1, and the grips' power is R . v of the grips.
+void setQuasiStaticState(const Operators& ops, const Loading& loading, const VecX& q1, const VecX& reaction1,
+                         double U, double t, State& s) {
+  const double V = loading.velocity(t);
+  s.time = t;
+  s.loadingTime = t;  // the loading clock (adaptive rate) starts where the loading is, at phi = 1
+  s.appliedDisplacement = U;
+  s.q = U * q1;
+  s.v = V * q1;
+  s.a = loading.acceleration(t) * q1;
+  s.reaction = U * reaction1;
+  double power = 0;
+  for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) power += s.reaction[i] * ops.prescribedShape[i] * V;
+  s.lastExternalPower = power;
+}
+
+}  // namespace
+
+StaticStart Simulation::startFromStaticElastic(double fraction) {
+  StaticStart st;
+  st.fraction = fraction;
+  solveStaticElastic(1.0);
+  const VecX q1 = state.q, reaction1 = state.reaction;
+  st.firstDamageDisplacement = computeFirstDamageDisplacement(model, materials, ops, q1, state.beamBroken,
+                                                              params.interfaces_breakable, st.limitedByRod);
+  if (!(std::isfinite(st.firstDamageDisplacement) && st.firstDamageDisplacement > 0))
+    throw IntegratorError("static_start = " + std::to_string(fraction) +
+                          ": no interface opens and no rod element is stressed under the applied displacement "
+                          "(first-damage displacement U_c = " + std::to_string(st.firstDamageDisplacement) +
+                          "): there is no elastic stage to skip; use static_start = 0");
+  st.displacement = fraction * st.firstDamageDisplacement;
+  st.time = materials.loading.timeOfDisplacement(st.displacement);
+  setQuasiStaticState(ops, materials.loading, q1, reaction1, st.displacement, st.time, state);
+  // each interface's history at its current (elastic) separation
+  VecX f;
+  state.failedInterfaces = computeForcesForInterfaces(model, materials.law, ops, state.q, state.lambdaMax, true, f);
+  integrator->initialise(model, materials, ops, state);
+  // the grips did the work the specimen holds (quasi-statically: no damping work is booked for the skipped stage)
+  state.externalWork = strainEnergyOfBeams() + strainEnergyOfInterfaces() + integrator->kineticEnergy(ops, state);
+  return st;
+}
+
 // --- the level above a scheme's step -------------------------------------------------------------------
 
 /// One time step: the scheme's step; delete overloaded rods; measure the crack when something broke.

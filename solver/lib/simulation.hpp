@@ -2,6 +2,8 @@
 // The simulation: the plain data of a run (state.hpp) and its integrator, the level above a scheme's step
 // (rod deletions, crack tracking), and the measurements (J at the outer boundary, crack advance, energy
 // balance). DESIGN.md sections 3-5.
+#include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -21,6 +23,26 @@ struct Measurement {
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)
   double rateMultiplier = 1;  // phi of the adaptive loading rate (loading_rate.hpp; 1 when off)
 };
+
+/// What a static elastic start (case key static_start, Simulation::startFromStaticElastic) did; plain data,
+/// kept in the run record (output /meta, checkpoint). fraction = 0: the run started from rest.
+struct StaticStart {
+  double fraction = 0;                   // case key static_start
+  double firstDamageDisplacement = NAN;  // U_c: applied displacement at which the first interface reaches
+                                         // delta0 or the first rod element its strength (static, linear)
+  double displacement = 0;               // U* = fraction x U_c, where the run starts
+  double time = 0;                       // t*: Loading::displacement(t*) = U*
+  bool limitedByRod = false;             // U_c set by a rod element's strength (else by an interface)
+  double solveSeconds = 0;               // wall time of the static solve and the start state (set by the runner)
+};
+
+/// U_c of a static elastic displacement field q1 at unit applied displacement (linear: every opening and rod
+/// stress scales with U): the smallest of delta0 / max_i lambda_i(q1) over the interfaces (when breakable)
+/// and 1 / max_e sigma_e(q1) / sigma_ru,e over the intact rod elements (when breakable); infinite when
+/// nothing opens or is stressed. limitedByRod says which set it.
+double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const Operators& ops, const VecX& q1,
+                                      const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable,
+                                      bool& limitedByRod);
 
 /// Worker threads the force loops use (set from the case key `threads` when a Simulation is built).
 int threadCount();
@@ -53,6 +75,13 @@ class Simulation {
   /// Replace the state by the static elastic solution at applied displacement U (intact interfaces elastic,
   /// deleted rods left out) and set the reactions: the reference for J and compliance checks.
   void solveStaticElastic(double U);
+  /// Static elastic start (case key static_start = fraction > 0): the static elastic solution q1 at U = 1,
+  /// U_c (computeFirstDamageDisplacement), U* = fraction U_c, t* with U(t*) = U*; then the quasi-static state
+  /// of the loading at t*: q = U* q1, v = U'(t*) q1, a = U''(t*) q1, time t*, each interface's history at its
+  /// current separation, reactions U* K_t q1, external work = the energy the specimen then holds (strain and
+  /// kinetic: what the grips did, quasi-statically), and the integrator initialised from it. step stays 0.
+  /// Throws IntegratorError when U_c is not finite and positive (nothing opens: no damage to start before).
+  StaticStart startFromStaticElastic(double fraction);
 
   // --- measurements ---
   Measurement measure() const;

@@ -33,6 +33,9 @@ struct Loading {
   double displacement(double t) const;
   double velocity(double t) const;
   double acceleration(double t) const;
+  /// The time t >= 0 at which displacement(t) = U (U >= 0): closed form after the ramp, bisection within it
+  /// (displacement is strictly increasing for t > 0).
+  double timeOfDisplacement(double U) const;
 };
 
 /// Set up once from the case; a run never changes it.

@@ -1,8 +1,10 @@
 // The kernels on a small model (kernels.hpp): the per-node gather of interface forces is the sum of the
 // tested pointwise function cohesive::computeInterfaceForces, and errors map to their exit statuses (a failed
-// factorisation is a failed run, 11; a refused time step is bad input, 7).
+// factorisation is a failed run, 11; a refused time step is bad input, 7); the inverse of the loading and the
+// static elastic start (case key static_start).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -95,5 +97,71 @@ TEST(Kernels, RefusedTimeStepIsOutOfRange) {
     FAIL() << "dt_factor 0.5 should be refused";
   } catch (const IntegratorError& e) {
     EXPECT_EQ(exitCodeOf(e), exit_code::out_of_range) << e.what();
+  }
+}
+
+// Loading::timeOfDisplacement inverts Loading::displacement inside the ramp (bisection), after it (closed
+// form), and without a ramp.
+TEST(Kernels, TimeOfDisplacementInvertsTheLoading) {
+  for (double rampTime : {0.0, 40.0}) {
+    const Loading loading{0.003, rampTime};
+    for (double t : {0.0, 1e-3, 0.7, 13.0, 39.9, 40.0, 41.0, 500.0}) {
+      const double U = loading.displacement(t);
+      EXPECT_NEAR(loading.displacement(loading.timeOfDisplacement(U)), U, 1e-13 * std::max(U, 1e-3))
+          << "ramp " << rampTime << " t " << t;
+      if (t > 1.0) EXPECT_NEAR(loading.timeOfDisplacement(U), t, 1e-9 * t) << "ramp " << rampTime;
+    }
+  }
+}
+
+// The static elastic start: the state is static equilibrium at U* = fraction U_c (free DOFs carry no net
+// force), its most loaded interface or rod element sits at exactly `fraction` of its limit, nothing is
+// inelastic, the time is where the loading reaches U*, and the external work is what the specimen holds.
+TEST(Kernels, StaticStartIsEquilibriumAtAFractionOfFirstDamage) {
+  for (const char* integrator : {"lumped", "paper"}) {
+    Simulation sim(smallCase(std::string("integrator = \"") + integrator + "\"\n"));
+    const double fraction = 0.9;
+    const StaticStart st = sim.startFromStaticElastic(fraction);
+    const State& s = sim.state;
+    ASSERT_TRUE(std::isfinite(st.firstDamageDisplacement) && st.firstDamageDisplacement > 0);
+    EXPECT_DOUBLE_EQ(st.displacement, fraction * st.firstDamageDisplacement);
+    EXPECT_NEAR(s.appliedDisplacement, st.displacement, 1e-12 * st.displacement);
+    EXPECT_NEAR(sim.materials.loading.displacement(s.time), st.displacement, 1e-12 * st.displacement);
+    EXPECT_EQ(s.step, 0);
+    // the limit that sets U_c is reached at exactly `fraction` of it
+    double worstLambda = 0;
+    for (double lm : s.lambdaMax) worstLambda = std::max(worstLambda, lm);
+    std::vector<double> ratio;
+    computeStressRatiosForBeams(sim.model, sim.materials, s.q, s.beamBroken, ratio);
+    const double worstRod = *std::max_element(ratio.begin(), ratio.end());
+    const double used = st.limitedByRod ? worstRod : worstLambda / sim.materials.law.delta0();
+    EXPECT_NEAR(used, fraction, 1e-9) << integrator;
+    EXPECT_LT(worstRod, 1.0);
+    EXPECT_EQ(sim.countInelasticInterfaces(), 0);
+    // static equilibrium: K q + f_iface = 0 on the free DOFs (to the solve's round-off)
+    std::vector<double> lambda = s.lambdaMax;
+    VecX fI;
+    computeForcesForInterfaces(sim.model, sim.materials.law, sim.ops, s.q, lambda, false, fI);
+    const VecX residual = sim.ops.K * s.q + fI;
+    double worstFree = 0;
+    for (int dof : sim.ops.freeDofs) worstFree = std::max(worstFree, std::abs(residual[dof]));
+    EXPECT_LT(worstFree, 1e-8 * s.reaction.cwiseAbs().maxCoeff()) << integrator;
+    // the grips' work is the energy held: balance error 0 in the first history row
+    const Measurement r = sim.measure();
+    EXPECT_NEAR(r.balanceError, 0.0, 1e-12) << integrator;
+    EXPECT_GT(r.strainBeams + r.strainInterfaces, 0.0);
+    EXPECT_LT(r.kinetic, 1e-3 * (r.strainBeams + r.strainInterfaces)) << integrator;
+  }
+}
+
+// Nothing to start before: with unbreakable interfaces and rods U_c is infinite; refused as bad input (7).
+TEST(Kernels, StaticStartWithoutDamageIsRefused) {
+  Simulation sim(smallCase("integrator = \"lumped\"\ninterfaces_breakable = false\nrods_breakable = false\n"));
+  try {
+    sim.startFromStaticElastic(0.5);
+    FAIL() << "static start without any damage limit should be refused";
+  } catch (const IntegratorError& e) {
+    EXPECT_EQ(exitCodeOf(e), exit_code::out_of_range) << e.what();
+    EXPECT_NE(std::string(e.what()).find("static_start"), std::string::npos) << e.what();
   }
 }
