@@ -51,13 +51,15 @@ REFERENCE = "paper"
 
 # Variants: name -> (--set overrides, threads). `paper` is the reference. dt_factor is dt over the smallest
 # period of the integrator's own system (lumped: stable up to ~0.187 with damping_cap 1, ~0.236 with 0.5).
-def lumped(dt_factor=0.1, damping_cap=1.0, rate_factor=1.0) -> dict:
-    return {"integrator": '"lumped"', "dt_factor": dt_factor, "damping_cap": damping_cap, "rate_factor": rate_factor}
+def lumped(dt_factor=0.1, damping_cap=1.0, rate_factor=1.0, static_start=0.0, rate_adapt_max=1.0) -> dict:
+    return {"integrator": '"lumped"', "dt_factor": dt_factor, "damping_cap": damping_cap, "rate_factor": rate_factor,
+            "static_start": static_start, "rate_adapt_max": rate_adapt_max}
 
 
 # Every knob is set explicitly, so that a preset that changes one does not change the bench.
 VARIANTS = {
-    "paper": ({"integrator": '"paper"', "dt_factor": 0.1, "rate_factor": 1.0}, 1),
+    "paper": ({"integrator": '"paper"', "dt_factor": 0.1, "rate_factor": 1.0, "static_start": 0.0,
+               "rate_adapt_max": 1.0}, 1),
     "lumped": (lumped(), 1),
     "lumped dt0.15": (lumped(dt_factor=0.15), 1),
     "lumped dt0.18": (lumped(dt_factor=0.18), 1),
@@ -68,6 +70,11 @@ VARIANTS = {
     "lumped dt0.18 rate4": (lumped(dt_factor=0.18, rate_factor=4), 1),
     "lumped cap0.5 dt0.22 rate2": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=2), 1),
     "lumped cap0.5 dt0.22 rate4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=4), 1),
+    # fewer steps (issue "Performance"): the static elastic start, the adaptive loading rate, both
+    "lumped cap0.5 dt0.22 static": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95), 1),
+    "lumped cap0.5 dt0.22 adapt4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_adapt_max=4), 1),
+    "lumped cap0.5 dt0.22 static adapt4": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95,
+                                                  rate_adapt_max=4), 1),
     "lumped 2 threads": (lumped(), 2),
 }
 TWO_THREAD_CASES = CASES[:1]   # the 2-thread variant runs on the first case only (it needs both cores)
@@ -468,6 +475,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
     ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")
+    ap.add_argument("--cases", nargs="+", choices=CASES, help="only these cases (default: all)")
+    ap.add_argument("--variants", nargs="+", choices=list(VARIANTS),
+                    help=f"only these variants (default: all; `{REFERENCE}` is always run: it is the reference)")
     ap.add_argument("--profile-only", action="store_true",
                     help="only the kernel profile (bench/profile.md): a few minutes")
     ap.add_argument("--replot", action="store_true",
@@ -481,6 +491,10 @@ def main(argv=None) -> int:
         return 2
     global PRESET
     variants, cases, sizes, extra = VARIANTS, CASES, COST_SIZES, {}
+    if a.cases:
+        cases = a.cases
+    if a.variants:
+        variants = {k: VARIANTS[k] for k in VARIANTS if k == REFERENCE or k in a.variants}
     if a.quick:
         PRESET = "ci"
         variants = {k: VARIANTS[k] for k in ("paper", "lumped", "lumped rate2")}

@@ -12,10 +12,14 @@ constexpr double kPi = 3.14159265358979323846;
 //           200 x 200 d (paper preset): 231k nodes 1630 MB            -> ~6.5-7 kB per node
 //   paper   40 x 20 d: 4640 nodes 65 MB;  40 x 40 d: 9284 nodes 120 MB -> 6.4 kB per node + ~52 B per node
 //           per node of a slice (the Cholesky factor's fill grows with the bandwidth)
+//   static_start > 0 adds the elastic stiffness's Cholesky factor (rods and interfaces; OpenBLAS): lumped
+//           40 x 20 d 59 -> 130 MB, 200 x 200 d 1630 -> 7520 MB: ~14.2 kB per node + ~33 B per node of a slice
 // The constants round these up by ~10%.
 constexpr double kLumpedBytesPerNode = 7000;
 constexpr double kPaperBytesPerNode = 6500;
 constexpr double kPaperFillBytesPerNodeSliceNode = 60;
+constexpr double kStaticBytesPerNode = 15600;
+constexpr double kStaticFillBytesPerNodeSliceNode = 36;
 constexpr double kBaseBytes = 30e6;  // the executable, libraries and the transverse-modulus block
 }  // namespace
 
@@ -30,6 +34,7 @@ ResourceEstimate estimateResources(const CaseParams& p) {
   e.memoryBytes = kBaseBytes + (p.integrator == "paper"
                                     ? e.nodes * (kPaperBytesPerNode + kPaperFillBytesPerNodeSliceNode * perSlice)
                                     : e.nodes * kLumpedBytesPerNode);
+  if (p.static_start > 0) e.memoryBytes += e.nodes * (kStaticBytesPerNode + kStaticFillBytesPerNodeSliceNode * perSlice);
   return e;
 }
 
