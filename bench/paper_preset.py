@@ -181,7 +181,9 @@ def report() -> int:
     L = [f"# One `{PRESET}`-preset case (`make bench-paper`, report {date})", "",
          f"Case `{CASE}` at the `{PRESET}` preset ({r.param('w_s_over_d'):g} d x {r.param('h_s_over_d'):g} d, "
          f"h_e = {r.param('h_e_over_d'):g} d, {dof:,} DOF, v_app = {r.param('v_app_over_cd'):g} c_d), "
-         f"variant `{VARIANT}` ({m['integrator_details']}), {threads} threads. "
+         f"variant `{VARIANT}`"
+         + (" with " + ", ".join(f"`{k}={v}`" for k, v in EXTRA_SETS.items()) if EXTRA_SETS else "")
+         + f" ({m['integrator_details']}), {threads} threads. "
          f"Machine: {run_bench.machine()}. Solver {m['git_hash']}.", "",
          f"- status: **{r.status}**" + (f" ({m['stop_reason']})" if m.get("stop_reason") else "") +
          ("" if r.completed else " — not finished: `make bench-paper` continues it"),
