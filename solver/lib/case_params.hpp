@@ -93,7 +93,8 @@ enum class Need { required, optional };
       "twins (paper: 50% slower loading) use 0.5 on top of the preset's rate")                                      \
     X(rate_adapt_max, Real, numerics, optional, 1, "[]", 1, 1000, "", "-",                                          \
       "adaptive loading rate: the largest multiplier phi it may apply on top of v_app (1 = off); at each "         \
-      "history row, with rho = kinetic / strain energy (rods + interfaces), phi is halved (not below 1) when a "    \
+      "history row, with rho = kinetic energy beyond the quasi-static motion of proportional loading (history "  \
+      "column kinetic_energy_beyond_loading) / strain energy (rods + interfaces), phi is halved (not below 1) when a "    \
       "rod element was deleted in the interval or rho > 0.01, x1.25 (not above this) when rho < 0.0025 and no rod " \
       "element was deleted and no more interfaces failed than 4 x the pre-cracked interfaces of one slice, else "   \
       "held; phi "                                                                                                  \

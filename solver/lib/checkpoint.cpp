@@ -14,9 +14,10 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 4;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 5;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
-                                       // the record's static elastic start
+                                       // the record's static elastic start; 5: history rows hold the kinetic
+                                       // energy beyond the loading's motion
 
 struct Writer {
   std::ofstream out;

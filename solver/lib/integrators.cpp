@@ -117,6 +117,10 @@ class PaperIntegrator : public Integrator {
   void updateOperators(const Operators& ops) override { factorise(ops, false); }
 
   double kineticEnergy(const Operators& ops, const State& s) const override { return 0.5 * s.v.dot(ops.M * s.v); }
+  double kineticEnergyBeyond(const Operators& ops, const State& s, double rate) const override {
+    const VecX w = s.v - rate * s.q;
+    return 0.5 * w.dot(ops.M * w);
+  }
 
  private:
   // w = v_n + dt/2 a_n
@@ -422,6 +426,10 @@ class LumpedIntegrator : public Integrator {
 
   double kineticEnergy(const Operators&, const State& s) const override {
     return 0.5 * s.vHalf.dot(mass_.cwiseProduct(s.vHalf));
+  }
+  double kineticEnergyBeyond(const Operators&, const State& s, double rate) const override {
+    const VecX w = s.vHalf - rate * s.q;
+    return 0.5 * w.dot(mass_.cwiseProduct(w));
   }
 
  private:

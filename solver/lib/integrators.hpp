@@ -40,6 +40,10 @@ class Integrator {
   virtual void updateOperators(const Operators& ops) = 0;
   /// Kinetic energy 1/2 v^T M v with this scheme's mass matrix and velocity.
   virtual double kineticEnergy(const Operators& ops, const State& s) const = 0;
+  /// Kinetic energy of the motion beyond proportional loading: 1/2 w^T M w, w = v - rate q (rate = U'/U of the
+  /// grips): what is left of the velocity when the quasi-static motion q' = (U'/U) q of a linear specimen is
+  /// taken out (the adaptive loading rate's measure, loading_rate.hpp).
+  virtual double kineticEnergyBeyond(const Operators& ops, const State& s, double rate) const = 0;
   /// Whether the scheme's mass is the consistent one (ops.M); false for lumped-mass schemes.
   virtual bool usesConsistentMass() const { return true; }
   /// Whether the scheme's velocity is the half-step one (State::vHalf) rather than v_n (State::v).

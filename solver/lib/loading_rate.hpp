@@ -3,6 +3,12 @@
 // times as fast as the time t, and the rule that sets phi from the measured kinetic / strain energy and what
 // broke. Off (rate_adapt_max = 1): tau = t and every result is today's, bit for bit.
 //
+// The kinetic energy it uses is the part beyond the quasi-static motion: 1/2 w^T M w with w = v - (U'/U) q
+// (Measurement::kineticBeyond). The whole kinetic energy includes the loading's own motion, (U'/U)^2 q^T M q,
+// which in a large specimen is not small: at the `paper` preset after the static start it is 1.8% of the
+// strain energy (the specimen's slowest modes carry the grips' motion), above rho_hi at phi = 1, so a rule on
+// the whole kinetic energy never raised the rate there.
+//
 // The clock (State::loadingTime, State::rateMultiplier): dtau/dt = phi; the grips follow
 //   u_y = +/- U(tau) (1 - x/w_s),  velocity phi U'(tau),  acceleration phi^2 U''(tau) + phi' U'(tau),
 // with U the Loading of the case (ramped v_app). phi changes linearly over a control interval (from its value
@@ -22,7 +28,7 @@ constexpr int kRateBurstSlices = 4;       // a burst: more interfaces failed in 
 
 /// What the rate controller sees of one control interval (the history interval).
 struct RateControlInput {
-  double kinetic = 0;       // kinetic energy at the end of the interval
+  double kinetic = 0;       // kinetic energy beyond the loading's motion at the end of the interval
   double strain = 0;        // strain energy of rod elements + interfaces at the end of the interval
   int rodsDeleted = 0;      // rod elements deleted during the interval
   int interfacesFailed = 0; // interfaces that failed during the interval

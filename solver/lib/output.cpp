@@ -59,6 +59,9 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"J_over_Gamma", &M::J, "Gamma_i", "", true},
       {"da_over_d", &M::crackAdvance, "d"},
       {"kinetic_energy", &M::kinetic, eu},
+      {"kinetic_energy_beyond_loading", &M::kineticBeyond, eu,
+       "1/2 w^T M w, w = v - (U'/U) q: the kinetic energy left when the quasi-static motion of proportional "
+       "loading is taken out (the adaptive loading rate's measure)"},
       {"strain_energy_beams", &M::strainBeams, eu},
       {"strain_energy_interfaces", &M::strainInterfaces, eu},
       {"damping_dissipation", &M::damping, eu},

@@ -185,7 +185,7 @@ class RunLoop {
     const Measurement& now = h.back();
     const Measurement& before = h[h.size() - 2];
     RateControlInput in;
-    in.kinetic = now.kinetic;
+    in.kinetic = now.kineticBeyond;
     in.strain = now.strainBeams + now.strainInterfaces;
     in.rodsDeleted = now.brokenBeams - before.brokenBeams;
     in.interfacesFailed = now.failedInterfaces - before.failedInterfaces;

@@ -580,6 +580,10 @@ Measurement Simulation::measure() const {
   r.J = computeJ();
   r.crackAdvance = state.crackAdvance;
   r.kinetic = integrator->kineticEnergy(ops, state);
+  // beyond the quasi-static motion q' = (U'/U) q; U' the grips' velocity now
+  const double U = state.appliedDisplacement;
+  const double rate = U > 0 ? computeGripVelocity(materials.loading, state, 0.0, integrator->timeStep()) / U : 0.0;
+  r.kineticBeyond = integrator->kineticEnergyBeyond(ops, state, rate);
   r.strainBeams = strainEnergyOfBeams();
   r.strainInterfaces = strainEnergyOfInterfaces();
   r.damping = state.dampingWork;

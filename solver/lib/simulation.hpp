@@ -17,7 +17,7 @@ namespace enamel {
 struct Measurement {
   long step = 0;
   double time = 0, appliedDisplacement = 0, J = 0, crackAdvance = 0;
-  double kinetic = 0, strainBeams = 0, strainInterfaces = 0, damping = 0, fracture = 0, rodFracture = 0;
+  double kinetic = 0, kineticBeyond = 0, strainBeams = 0, strainInterfaces = 0, damping = 0, fracture = 0, rodFracture = 0;
   double external = 0, balanceError = 0;
   int brokenBeams = 0, failedInterfaces = 0, inelasticInterfaces = 0;
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)

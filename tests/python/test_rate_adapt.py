@@ -1,7 +1,7 @@
 """Adaptive loading rate (issue "Performance", item 2a; case key rate_adapt_max, solver/lib/loading_rate.hpp):
 a ci-size lumped run with rate_adapt_max = 8 raises the rate multiplier phi (/history/rate_multiplier) above 1
 while the specimen loads elastically, so the grips move faster than v_app on average; every history interval
-follows the rule (a rise x1.25 while elastic and rho = kinetic/strain < rho_lo, a halving after rho > rho_hi or a
+follows the rule (a rise x1.25 while elastic and rho = (kinetic energy beyond the loading's motion)/strain < rho_lo, a halving after rho > rho_hi or a
 rod deletion); the run keeps its energy balance and its kinetic/strain ratio within the run's bounds (no
 warnings), and continues bit for bit after SIGKILLs and --restart. rate_adapt_max = 1 (the default) is today's
 run bit for bit: test_reference_outputs."""
@@ -61,7 +61,7 @@ def test_each_interval_follows_the_rule(adaptive):
     while elastic and rho < rho_lo, halved (not below 1) after rho > rho_hi or a deletion."""
     h = adaptive["history"]
     phi = h["rate_multiplier"]
-    rho = h["kinetic_energy"] / np.maximum(h["strain_energy_beams"] + h["strain_energy_interfaces"], 1e-300)
+    rho = h["kinetic_energy_beyond_loading"] / np.maximum(h["strain_energy_beams"] + h["strain_energy_interfaces"], 1e-300)
     deleted = np.diff(h["broken_rod_elements"], prepend=0) > 0
     elastic = (h["da_over_d"] == 0) & (h["broken_rod_elements"] == 0) & (h["failed_interfaces"] == 0)
     raised = lowered = 0
