@@ -30,11 +30,12 @@ import numpy as np
 from enamel_results import results
 
 
-def nearest_distance(points: np.ndarray, targets: np.ndarray, chunk: int = 4096) -> np.ndarray:
+def nearest_distance(points: np.ndarray, targets: np.ndarray) -> np.ndarray:
     """For each point (n, 2), the distance to the nearest target (m, 2); inf when there are no targets."""
     if len(targets) == 0:
         return np.full(len(points), np.inf)
     out = np.empty(len(points))
+    chunk = max(1, 2_000_000 // len(targets))   # ~50 MB of differences at a time
     for i in range(0, len(points), chunk):
         p = points[i:i + chunk, None, :]
         out[i:i + chunk] = np.sqrt(((p - targets[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
