@@ -514,12 +514,7 @@ class LumpedIntegrator : public Integrator {
   // v_{n+1/2} replaces v_{n-1/2};  q_{n+1} = q_n + dt v_{n+1/2}
   void advancePositions(State& s) {
     s.vHalf.swap(vNext_);
-    double* q = s.q.data();
-    const double* v = s.vHalf.data();
-    const double dt = dt_;
-    const Eigen::Index n = s.q.size();
-#pragma omp parallel for schedule(static)
-    for (Eigen::Index i = 0; i < n; ++i) q[i] += dt * v[i];
+    enamel::advancePositions(s.q, s.vHalf, dt_);
   }
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;

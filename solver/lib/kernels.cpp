@@ -127,6 +127,15 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
   return failed;
 }
 
+// --- positions ---------------------------------------------------------------------------------------
+void advancePositions(VecX& q, const VecX& v, double dt) {
+  double* x = q.data();
+  const double* w = v.data();
+  const Eigen::Index n = q.size();
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index i = 0; i < n; ++i) x[i] += dt * w[i];
+}
+
 // --- rod elements --------------------------------------------------------------------------------------
 namespace {
 // sigma = max tensile stress of the local end forces f_l = (K_local T) u_e, of which only the rows

@@ -41,6 +41,9 @@ void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3*
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, VecX& f);
 
+/// q += dt v over all DOF (threaded): the explicit schemes' position update.
+void advancePositions(VecX& q, const VecX& v, double dt);
+
 /// Largest tensile stress of rod element e (units of E_r): beam::maxTensileStress of its local end forces.
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e);
 /// Stress ratio sigma / sigma_ru of every intact rod element (0 for deleted ones): the deletion check.

@@ -2,7 +2,9 @@
 that several modules read, each made once per session (ci_run, tiny_run)."""
 import os
 import pathlib
+import signal
 import subprocess
+import time
 
 import pytest
 
@@ -62,3 +64,37 @@ def tiny_run(run, tmp_path_factory):
     """tiny_run(case): the paper case at the tiny ci variant TINY_SETS, run once per session (figures and VTK
     export tests); tiny_run.root is the runs/ root of all of them."""
     return SessionRuns(run, tmp_path_factory.mktemp("tiny_runs"), TINY_SETS)
+
+
+def checkpoint_stamp(out):
+    """The checkpoint's modification time (ns) in run directory `out`, or None while there is none."""
+    try:
+        return (pathlib.Path(out) / "checkpoint.bin").stat().st_mtime_ns
+    except FileNotFoundError:
+        return None
+
+
+def run_with_kills(enamel, out, args, delays, timeout=900):
+    """Run enamel-dem to completion in `out`, killed with SIGKILL once per entry of `delays`: each piece is killed
+    `delay` s after it wrote a checkpoint of its own (so every kill lands between checkpoints whatever the
+    machine's speed), and the next piece continues it with --restart. args(extra) gives the solver's arguments
+    with `extra` (the checkpoint interval, --restart) appended. Returns the number of kills that landed (fewer
+    than len(delays) when a piece finished first)."""
+    kills = 0
+    for delay in list(delays) + [None]:
+        before = checkpoint_stamp(out)
+        extra = ["--checkpoint-every", "0.1"] + (["--restart"] if kills else [])
+        p = subprocess.Popen([str(enamel), *map(str, args(extra))], stderr=subprocess.PIPE, text=True)
+        if delay is not None:
+            while p.poll() is None and checkpoint_stamp(out) in (None, before):
+                time.sleep(0.005)
+            time.sleep(delay)
+            if p.poll() is None:
+                p.send_signal(signal.SIGKILL)
+                p.wait()
+                kills += 1
+                continue
+        _, err = p.communicate(timeout=timeout)
+        assert p.returncode == 0, err
+        return kills
+    return kills

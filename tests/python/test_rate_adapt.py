@@ -5,15 +5,12 @@ follows the rule (a rise x1.25 while elastic and rho = (kinetic energy beyond th
 rod deletion); the run keeps its energy balance and its kinetic/strain ratio within the run's bounds (no
 warnings), and continues bit for bit after SIGKILLs and --restart. rate_adapt_max = 1 (the default) is today's
 run bit for bit: test_reference_outputs."""
-import signal
-import subprocess
-import time
 
 import h5py
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, run_with_kills
 
 CASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
 SETS = ["stop_da_over_d=2", "threads=1"]   # the ci preset stopped early: about 15 s
@@ -82,34 +79,11 @@ def test_adaptive_run_stays_quasi_static_and_balanced(adaptive):
     assert meta["max_kinetic_over_strain_while_growing"] < KINETIC_WARN
 
 
-def checkpoint_stamp(out):
-    try:
-        return (out / "checkpoint.bin").stat().st_mtime_ns
-    except FileNotFoundError:
-        return None
-
-
 def test_restart_of_adaptive_run_is_bit_for_bit(enamel, adaptive, tmp_path):
     """Killed (SIGKILL) twice after a checkpoint while phi moves, continued with --restart: the same history
     (phi included), R-curve and step count as the uninterrupted run."""
     out = tmp_path / "killed"
-    kills = 0
-    for delay in (0.05, 0.3, None):
-        extra = ["--checkpoint-every", "0.1"] + (["--restart"] if kills else [])
-        before = checkpoint_stamp(out)
-        p = subprocess.Popen([str(enamel), *map(str, args_for(out, 8, *extra))], stderr=subprocess.PIPE, text=True)
-        if delay is not None:
-            while p.poll() is None and checkpoint_stamp(out) in (None, before):
-                time.sleep(0.005)
-            time.sleep(delay)
-            if p.poll() is None:
-                p.send_signal(signal.SIGKILL)
-                p.wait()
-                kills += 1
-                continue
-        _, err = p.communicate(timeout=600)
-        assert p.returncode == 0, err
-        break
+    kills = run_with_kills(enamel, out, lambda extra: args_for(out, 8, *extra), [0.05, 0.3], timeout=600)
     assert kills == 2, f"only {kills} kills landed after a checkpoint (run too short?)"
     a, b = adaptive, read(out / "result.h5")
     assert a["meta"]["steps"] == b["meta"]["steps"]

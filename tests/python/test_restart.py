@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, checkpoint_stamp, run_with_kills
 
 CASE = ROOT / "paper_cases" / "theta30_s7.1_e10_cv0.toml"   # rods and interfaces break: deletions replay
 # a small, fast variant of the ci preset (about 2 s); the kill test checkpoints every 0.1 s of wall time
@@ -42,37 +42,14 @@ def uninterrupted(run, tmp_path_factory):
     return out / "result.h5", time.time() - t0
 
 
-def checkpoint_stamp(out):
-    """The checkpoint's modification time (ns), or None while there is none."""
-    try:
-        return (out / "checkpoint.bin").stat().st_mtime_ns
-    except FileNotFoundError:
-        return None
-
-
 def test_sigkill_and_restart_gives_identical_rcurve(enamel, uninterrupted, tmp_path):
     # Each piece is killed at a random moment after it has written a checkpoint of its own, so every kill lands
     # between checkpoints whatever the machine's speed (a kill timed by wall clock alone outran a 1.7 s run).
     whole, _ = uninterrupted
     rng = random.Random(20261123)
     out = tmp_path / "killed"
-    kills = 0
-    for piece in range(KILLS + 1):
-        extra = ["--checkpoint-every", "0.1"] + (["--restart"] if kills else [])
-        before = checkpoint_stamp(out)
-        p = subprocess.Popen([str(enamel), *map(str, args_for(out, *extra))], stderr=subprocess.PIPE, text=True)
-        if kills < KILLS:
-            while p.poll() is None and checkpoint_stamp(out) in (None, before):
-                time.sleep(0.005)
-            time.sleep(rng.uniform(0.0, 0.15))
-            if p.poll() is None:
-                p.send_signal(signal.SIGKILL)
-                p.wait()
-                kills += 1
-                continue
-        _, err = p.communicate(timeout=900)
-        assert p.returncode == 0, err
-        break
+    kills = run_with_kills(enamel, out, lambda extra: args_for(out, *extra),
+                           [rng.uniform(0.0, 0.15) for _ in range(KILLS)])
     assert kills == KILLS, f"only {kills} kills landed after a checkpoint (run too short?)"
     a, b = curves(whole), curves(out / "result.h5")
     assert b[5] == "completed"
