@@ -8,6 +8,8 @@
 #                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
 #                 number of cores). A run that was stopped continues from its checkpoint.
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
+#                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=8"): --set on every run, in a runs
+#                 folder and a figures folder of their own (runs/set_<keys>/, figures/out/set_<keys>/)
 #   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
 #                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
 #                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
@@ -54,8 +56,22 @@ PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
 ENAMEL := $(BUILD_DIR)/enamel-dem
 PRESET ?= reduced
 PRESETS := ci reduced paper
+# Where the runs and the figures go. RUN_SET (below) changes the runs' physics or numerics, which Make does not
+# track, so a RUN_SET without RUNS on the command line gets a folder of its own, named after it:
+#   make figures RUN_SET="Gamma_k_over_sigma0sq=8"  ->  runs/set_Gamma_k_over_sigma0sq-8/<preset>/<case>/result.h5,
+#                                                       figures/out/set_Gamma_k_over_sigma0sq-8/<preset>/
+# and never mixes with (or counts as done because of) the default runs in runs/<preset>/.
+empty :=
+space := $(empty) $(empty)
+set_tag = $(subst /,-,$(subst ',,$(subst ",,$(subst =,-,$(subst $(space),_,$(strip $(1)))))))
+ifneq ($(filter command line environment,$(origin RUNS)),)
+else ifneq ($(strip $(RUN_SET)),)
+RUNS := runs/set_$(call set_tag,$(RUN_SET))
+else
 RUNS := runs
-FIG_OUT := figures/out/$(PRESET)
+endif
+FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
+FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
 .PHONY: bench bench-paper identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
   vtk reference clean-runs check-preset slurm
@@ -128,8 +144,8 @@ check-preset:
 # make), the next `make` re-runs exactly the unfinished cases; --resume continues each from its checkpoint
 # (written every CHECKPOINT_EVERY s) when the case and the solver binary are unchanged, and from step 0
 # otherwise, saying which in the log (appended to, one piece after another).
-# RUN_SET="key=value ..." adds --set overrides to every run (experiments, tests; Make does not track them:
-# use another RUNS= folder for another setting).
+# RUN_SET="key=value ..." adds --set overrides to every run (sweeps, experiments, tests). Make does not track them,
+# so without RUNS= on the command line they get a runs folder of their own (RUNS above).
 RUN_SETS := $(foreach s,$(RUN_SET),--set $(s))
 define run_case
 	@mkdir -p $(@D)
@@ -167,13 +183,13 @@ FIG_COMMON := figures/plotting.py $(wildcard enamel_results/*.py) figures/paper_
 define figure_rule
 $(FIG_OUT)/$(basename $(notdir $(call fig_script,$(1)))).png: $(call fig_script,$(1)) $(FIG_COMMON) \
     $(call run_targets,$($(shell echo $(1) | tr a-z A-Z)_CASES),$($(shell echo $(1) | tr a-z A-Z)_SLOW))
-	$(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET)
+	$(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
 endef
 $(foreach f,$(FIGURES),$(eval $(call figure_rule,$(f))))
 FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(f)))).png)
 
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
-	$(PYTHON) -m figures.summary_table --preset $(PRESET)
+	$(PYTHON) -m figures.summary_table --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
 
 figures: check-preset
 	$(call parallel,figures)

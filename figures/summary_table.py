@@ -142,6 +142,23 @@ def check_trends(results, pv):
     return out
 
 
+def overrides_line(results) -> str:
+    """Where the runs are and which --set overrides they ran with beyond their preset and case file (from each
+    run's /meta case_toml; `threads` changes nothing and the half-rate twins' `rate_factor` is their column)."""
+    sets = set()
+    for r in results.values():
+        for line in str(r.meta.get("case_toml", "")).splitlines():
+            item = line[len("# --set "):].strip() if line.startswith("# --set ") else ""
+            if item and not item.replace(" ", "").startswith(("threads=", "rate_factor=")):
+                sets.add(item)
+    roots = sorted({str(r.path.parent.parent.parent) for r in results.values()})
+    where = f"Runs: {', '.join(roots)}." if roots else "No runs found."
+    if not sets:
+        return where + " Every run at its preset and case file (no --set overrides beyond threads)."
+    return (where + " **Every value below is for runs with --set " + " ".join(sorted(sets)) +
+            "** beyond their preset and case file: not the default model.")
+
+
 def write_markdown(path, preset, rows, results, pv, trends):
     short = ["case", "figures", "status", "da_max_over_d", "R_init_over_Gamma", "R_ss_over_Gamma",
              "R_m_over_Gamma", "dR_m_over_Gamma", "da_first_rod_fracture_over_d", "broken_rod_elements",
@@ -155,7 +172,7 @@ def write_markdown(path, preset, rows, results, pv, trends):
             return v
         return "%.4g" % float(v) if col != "wall_time_s" else "%.0f" % float(v)
 
-    lines = [f"# Summary of the {preset} preset runs", "",
+    lines = [f"# Summary of the {preset} preset runs", "", overrides_line(results), "",
              "R normalised by Gamma_i, crack advance by d. R_init: first R with Delta_a > 0; R_ss: mean R over "
              "the last 20% of the advance reached (the paper: R at Delta_a/d ~ 30); R_m, Delta R_m: mean and "
              "standard deviation of R over 0 < Delta_a/d < 30 of this run. `paper` columns: the values the paper "

@@ -213,6 +213,11 @@ def test_summary_table_rows_columns_and_values(tiny_runs, tmp_path):
     assert by_case["theta30_s28.5_e10_cv0.3_seed1"]["paper_R_m_pooled_over_Gamma"] == "5.95"
     md = (tmp_path / "ci" / "summary.md").read_text()
     assert "| theta30_s21.4_e10_cv0 |" in md and "Trends the paper states" in md
+    # the tiny runs' --set overrides are named at the top (not the default model), threads is not
+    head = md.split("\n| case |")[0]
+    assert f"Runs: {tiny_runs}." in head and "not the default model" in head, head
+    assert all(s in head for s in ("w_s_over_d=8", "stop_da_over_d=1.5", "frames_da_over_d=[0.5, 1.5]")), head
+    assert "threads=" not in head and "rate_factor=" not in head, head
 
 
 def test_summary_table_without_allow_missing_fails(tiny_runs, tmp_path):

@@ -76,3 +76,27 @@ def test_make_killed_mid_run_resumes_bit_for_bit(enamel, tmp_path):
 
     r = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=120)   # done: nothing to run
     assert r.returncode == 0 and "run:" not in r.stdout, r.stdout
+
+
+def test_run_set_gets_runs_and_figures_folders_of_its_own():
+    """RUN_SET changes the physics, which Make does not track: without RUNS= its runs and figures go to folders
+    named after it (never runs/<preset>/, where default runs would count as done), and the figure scripts read
+    those runs; with RUNS= given, RUNS is kept."""
+    def dry(*extra):
+        r = subprocess.run(["make", "-n", "--no-print-directory", "figures-all", "PRESET=ci", "ENAMEL=/bin/true",
+                            *extra], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stdout + r.stderr
+        return r.stdout
+    out = dry('RUN_SET=Gamma_k_over_sigma0sq=8 section="circle"')
+    tag = "set_Gamma_k_over_sigma0sq-8_section-circle"
+    assert f"--out runs/{tag}/ci/theta30_s21.4_e10_cv0 " in out
+    assert "--set Gamma_k_over_sigma0sq=8 --set section=\"circle\"" in out or \
+           "--set Gamma_k_over_sigma0sq=8 --set section=circle" in out, out[:2000]
+    assert f"-m figures.fig4_decussation --preset ci --runs runs/{tag} --out figures/out/{tag}" in out
+    assert f"-m figures.summary_table --preset ci --runs runs/{tag} --out figures/out/{tag}" in out
+    assert " runs/ci/" not in out
+    out = dry()
+    assert "--out runs/ci/theta30_s21.4_e10_cv0 " in out
+    assert "-m figures.fig4_decussation --preset ci --runs runs --out figures/out" in out
+    out = dry("RUNS=/tmp/elsewhere", "RUN_SET=threads=1")
+    assert "--out /tmp/elsewhere/ci/theta30_s21.4_e10_cv0 " in out and "runs/set_" not in out
