@@ -1,4 +1,4 @@
-"""Reference-solver checks that run the binary at the `ci` preset (issue "Reference solver"):
+"""Reference-solver checks that run the binary at the `ci` preset (and one at `reduced`; issue "Reference solver"):
 theta_D = 0 gives R = 4/3 Gamma_i, half the loading rate gives the same R-curve, theta_D = 30 runs to its
 stop criterion with broken rods and a rising R-curve, and result.h5 has the documented layout.
 The theta_D = 0 and 30 runs are the session's shared ci runs (conftest.ci_run)."""
@@ -14,8 +14,8 @@ TOL_RATE = 0.02        # issue: half the loading rate gives an R-curve within 2%
 THETA0, THETA30 = "theta0_s21.4_e10_cv0", "theta30_s21.4_e10_cv0"
 
 
-def run_case(run, out, case, *sets):
-    args = ["run", PAPER_CASES / f"{case}.toml", "--preset", "ci", "--out", out, "--quiet"]
+def run_case(run, out, case, *sets, preset="ci"):
+    args = ["run", PAPER_CASES / f"{case}.toml", "--preset", preset, "--out", out, "--quiet"]
     for s in sets:
         args += ["--set", s]
     r = run(*args, timeout=900)
@@ -48,6 +48,21 @@ def test_theta0_gives_four_thirds(theta0):
     assert theta0["meta"].attrs["status"] == "completed"
     assert "stop_da_over_d" in theta0["meta"].attrs["stop_reason"]
     assert int(theta0["history/broken_rod_elements"][-1]) == 0, "no rod breaks at theta_D = 0"
+
+
+def test_theta0_gives_four_thirds_at_the_reduced_size_at_half_its_rate(run, tmp_path):
+    """The `reduced` specimen (40 x 20 d, Delta_a 12 d): within 3% of 4/3 at half the preset's loading rate
+    (measured 2026-12-02: R_init 1.365, R_ss 1.344). At the preset's own rate it is 1.402 / 1.385 (+5.2% / +3.9%):
+    the rate shows at this size (README, Results), which is why this check halves it. The static
+    elastic start (R-curve within ~1e-5 of a start from rest) keeps it to 1-2 min (one thread: two oversubscribed
+    OpenMP threads spin on a busy machine)."""
+    with run_case(run, tmp_path, THETA0, "rate_factor=0.5", "static_start=0.95", "threads=1",
+                  preset="reduced") as f:
+        R_init, R_ss = f["rcurve"].attrs["R_init_over_Gamma"], f["rcurve"].attrs["R_ss_over_Gamma"]
+        print(f"theta0 reduced, half rate: R_init/Gamma {R_init:.4f}  R_ss/Gamma {R_ss:.4f}")
+        assert f["meta"].attrs["status"] == "completed" and f["rcurve"].attrs["da_max_over_d"] >= 12
+        assert abs(R_init / R_THEORY - 1) < TOL_THEORY, R_init
+        assert abs(R_ss / R_THEORY - 1) < TOL_THEORY, R_ss
 
 
 def test_half_rate_gives_same_rcurve(theta0, theta0_half_rate):
