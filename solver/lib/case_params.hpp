@@ -56,6 +56,10 @@ enum class Need { required, optional };
     X(Gamma_k_over_sigma0sq, Real, physics, optional, 3, "[]", 1, 1e4, "", "sigma0^2/k",                            \
       "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "                        \
       "fracture length)")                                                                                           \
+    X(softening_over_delta0, Real, physics, optional, 1, "(]", 0, 2e4, "", "delta0",                               \
+      "interface softening length: (delta_f - delta1)/delta0, the length of the trapezoid's linear drop at "      \
+      "fixed Gamma_i (plateau end delta1 = Gamma_i/sigma0 + (delta0 - L)/2); 1 = the symmetric trapezoid, "        \
+      "2 Gamma_k_over_sigma0sq - 1 = the triangle (no plateau), the largest allowed")                             \
     X(delta0_over_d, Real, physics, optional, 0.1, "(]", 0, 1, "", "d",                                             \
       "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "          \
       "displacements, so results depend on it only through the loading rate: what is quasi-static is "              \

@@ -240,6 +240,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "Gamma_i", Gamma);
       attr(g.id, "sigma0", p.sigma0());
       attr(g.id, "k", p.k());
+      attr(g.id, "softening_over_delta0", p.softening_over_delta0);
       attr(g.id, "sigma_ru_mean", p.sigma_ru());
       const StaticStart& st = rec.staticStart;
       attr(g.id, "static_start", st.fraction);

@@ -38,7 +38,7 @@ beam::Section sectionOf(const CaseParams& p) {
 // Unbreakable interfaces (verification runs) keep the elastic branch however far they open.
 cohesive::Law lawOf(const CaseParams& p) {
   if (!p.interfaces_breakable) return cohesive::Law{p.k(), 1e300, 1e300};
-  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma());
+  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma(), p.softening_over_delta0);
 }
 
 // Add (sign x) a 12x12 element matrix into a triplet list / an existing sparse pattern.
