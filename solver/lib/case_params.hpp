@@ -69,6 +69,10 @@ enum class Need { required, optional };
     X(section, Choice, physics, optional, "hexagon", "[]", 0, 0, "hexagon|circle", "-",                             \
       "rod cross-section: hexagon = space-filling hexagon of across-flats width d, circle = "                       \
       "circle of diameter d")                                                                                       \
+    X(rod_stress, Choice, physics, optional, "axial_bending", "[]", 0, 0, "axial_bending|axial|principal", "-",   \
+      "rod stress definition: of the brittle check, max over both element ends of: axial_bending = N/A + "         \
+      "sqrt(My^2 + Mz^2) c/I; axial = N/A; principal = sigma/2 + sqrt((sigma/2)^2 + tau^2), sigma = "              \
+      "axial_bending, tau = |T| c/J (torsion only); tension positive, c = d/2")                                    \
     X(seed, Integer, physics, optional, 1, "[]", 0, 2147483647 /* 2^31 - 1 */, "", "-",                             \
       "random seed: of the rod-element strengths (mt19937_64 + Box-Muller)")                                        \
     X(rods_breakable, Bool, physics, optional, true, "[]", 0, 0, "", "-",                                           \

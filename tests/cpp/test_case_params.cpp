@@ -516,3 +516,12 @@ TEST(CaseParams, SofteningOverDelta0RangeDependsOnGamma) {
     EXPECT_EQ(nan.exitCode, exit_code::out_of_range);
     expectMessage(nan, {"'softening_over_delta0'", "nan"});
 }
+
+TEST(CaseParams, RodStressChoices) {
+    EXPECT_EQ(parse("").rod_stress, "axial_bending");
+    EXPECT_EQ(parse("", "", {"rod_stress=principal"}).rod_stress, "principal");
+    EXPECT_EQ(parse("rod_stress = \"axial\"\n").rod_stress, "axial");
+    const auto e = caseErrorOf([] { parse("rod_stress = \"von_mises\"\n"); });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    expectMessage(e, {"'rod_stress'", "\"von_mises\"", "\"axial_bending\"", "\"axial\"", "\"principal\""});
+}
