@@ -189,6 +189,34 @@ double maxTensileStress(const Section& s, const Vec12& fLocal) {
   return maxTensileStressOfRows(s, f);
 }
 
+RodStress parseRodStress(const std::string& name) {
+  if (name == "axial_bending") return RodStress::AxialBending;
+  if (name == "axial") return RodStress::Axial;
+  if (name == "principal") return RodStress::Principal;
+  throw std::invalid_argument("rod_stress '" + name + "' is not one of axial_bending, axial, principal");
+}
+
+// sigma = N/A, N = f_local[6] (tension positive)
+double axialStressOfRows(const Section& s, const Vec5& f) { return f[2] / s.A; }
+
+// sigma_1 = sigma/2 + sqrt((sigma/2)^2 + tau^2), tau = |T| c/J
+double principalStressOfRows(const Section& s, const Vec5& f, double torque) {
+  const double half = 0.5 * maxTensileStressOfRows(s, f);
+  const double tau = std::abs(torque) * s.c / s.J;
+  return half + std::sqrt(half * half + tau * tau);
+}
+
+double rodStress(RodStress kind, const Section& s, const Vec12& fLocal) {
+  Vec5 f;
+  for (int r = 0; r < 5; ++r) f[r] = fLocal[kStressRows[r]];
+  switch (kind) {
+    case RodStress::Axial: return axialStressOfRows(s, f);
+    case RodStress::Principal: return principalStressOfRows(s, f, fLocal[kTorsionRow]);
+    case RodStress::AxialBending: break;
+  }
+  return maxTensileStressOfRows(s, f);
+}
+
 // K phi = omega^2 M phi, ascending; negative round-off eigenvalues (rigid-body modes) clamped to 0.
 Eigen::VectorXd eigenfrequencies(const Mat12& K, const Mat12& M) {
   if (Eigen::LLT<Mat12>(M).info() != Eigen::Success)

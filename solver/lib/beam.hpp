@@ -13,6 +13,8 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <string>
+
 namespace enamel::beam {
 
 using Vec3 = Eigen::Vector3d;
@@ -72,6 +74,29 @@ inline constexpr int kStressRows[5] = {4, 5, 6, 10, 11};
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 // maxTensileStress of the end forces fLocal[kStressRows] (the code the solver runs; the Vec12 form calls it).
 double maxTensileStressOfRows(const Section& s, const Vec5& f);
+
+// Alternative rod stress definitions (case key rod_stress), for the paper's undefined "maximum rod stress
+// sigma_r,max"; the default axial_bending is maxTensileStressOfRows above. All are tension positive and
+// scale linearly with the displacements (positively homogeneous), as the static start's U_c needs.
+enum class RodStress { AxialBending, Axial, Principal };
+// "axial_bending" | "axial" | "principal"; throws std::invalid_argument naming the allowed values otherwise.
+RodStress parseRodStress(const std::string& name);
+
+// axial: sigma = N/A (N = f[2] = f_local[6], the same at both ends); needs only the kStressRows rows.
+double axialStressOfRows(const Section& s, const Vec5& f);
+
+// The torque the principal stress reads: T = f_local[kTorsionRow] (end b; = -f_local[3], constant along the
+// element). Only rod_stress = principal evaluates this 6th row, so the default's 5 rows and cost are unchanged.
+inline constexpr int kTorsionRow = 9;
+// principal: largest principal stress at the outer fibre of the most stressed end,
+//   sigma_1 = sigma/2 + sqrt((sigma/2)^2 + tau^2),  sigma = maxTensileStressOfRows(f),  tau = |T| c/J,
+// with tau from torsion only (no transverse shear) and c/J the circle's formula (exact for the circle, the
+// hexagon's c = d/2 and computed J otherwise). sigma_1 increases with sigma, and tau is the same at both ends,
+// so the max over the ends is sigma_1 of the max sigma. Equals sigma when T = 0 (up to round-off).
+double principalStressOfRows(const Section& s, const Vec5& f, double torque);
+
+// The stress of `kind` from all 12 local end forces (tests; the solver reads the rows it needs).
+double rodStress(RodStress kind, const Section& s, const Vec12& fLocal);
 
 // Free-free element eigenfrequencies omega (rad per unit time) of K phi = omega^2 M phi, ascending;
 // the six rigid-body zeros come out as round-off and are clamped at 0. M must be positive definite

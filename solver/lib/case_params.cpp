@@ -465,6 +465,13 @@ void checkCrossKeys(const CaseParams& p, const std::string& src) {
     // a0 = a0_over_ws w_s < w_s (guaranteed by the range of a0_over_ws; kept for clarity).
     if (!(p.a0() < p.w_s_over_d))
         fail("pre-crack a0 = " + formatNumber(p.a0()) + " d is not shorter than w_s = " + formatNumber(p.w_s_over_d) + " d");
+    // Trapezoid plateau end delta1 = Gamma/sigma0 + (delta0 - L)/2 >= delta0  <=>  L/delta0 <= 2 G - 1.
+    const double maxSoftening = 2.0 * p.Gamma_k_over_sigma0sq - 1.0;
+    if (!(p.softening_over_delta0 <= maxSoftening))
+        fail("key 'softening_over_delta0' = " + formatNumber(p.softening_over_delta0) +
+             " is out of range; allowed (0, 2 Gamma_k_over_sigma0sq - 1] = (0, " + formatNumber(maxSoftening) +
+             "] with Gamma_k_over_sigma0sq = " + formatNumber(p.Gamma_k_over_sigma0sq) +
+             " (above it the plateau end delta1 falls below delta0)");
     // Slices at x_k = k h_e for 0 <= x_k <= w_s.
     const double slices = std::floor(p.w_s_over_d / p.h_e_over_d + 1e-9) + 1;
     if (slices < 2)

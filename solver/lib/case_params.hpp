@@ -56,6 +56,10 @@ enum class Need { required, optional };
     X(Gamma_k_over_sigma0sq, Real, physics, optional, 3, "[]", 1, 1e4, "", "sigma0^2/k",                            \
       "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "                        \
       "fracture length)")                                                                                           \
+    X(softening_over_delta0, Real, physics, optional, 1, "(]", 0, 2e4, "", "delta0",                               \
+      "interface softening length: (delta_f - delta1)/delta0, the length of the trapezoid's linear drop at "      \
+      "fixed Gamma_i (plateau end delta1 = Gamma_i/sigma0 + (delta0 - L)/2); 1 = the symmetric trapezoid, "        \
+      "2 Gamma_k_over_sigma0sq - 1 = the triangle (no plateau), the largest allowed")                             \
     X(delta0_over_d, Real, physics, optional, 0.1, "(]", 0, 1, "", "d",                                             \
       "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "          \
       "displacements, so results depend on it only through the loading rate: what is quasi-static is "              \
@@ -65,6 +69,10 @@ enum class Need { required, optional };
     X(section, Choice, physics, optional, "hexagon", "[]", 0, 0, "hexagon|circle", "-",                             \
       "rod cross-section: hexagon = space-filling hexagon of across-flats width d, circle = "                       \
       "circle of diameter d")                                                                                       \
+    X(rod_stress, Choice, physics, optional, "axial_bending", "[]", 0, 0, "axial_bending|axial|principal", "-",   \
+      "rod stress definition: of the brittle check, max over both element ends of: axial_bending = N/A + "         \
+      "sqrt(My^2 + Mz^2) c/I; axial = N/A; principal = sigma/2 + sqrt((sigma/2)^2 + tau^2), sigma = "              \
+      "axial_bending, tau = |T| c/J (torsion only); tension positive, c = d/2")                                    \
     X(seed, Integer, physics, optional, 1, "[]", 0, 2147483647 /* 2^31 - 1 */, "", "-",                             \
       "random seed: of the rod-element strengths (mt19937_64 + Box-Muller)")                                        \
     X(rods_breakable, Bool, physics, optional, true, "[]", 0, 0, "", "-",                                           \

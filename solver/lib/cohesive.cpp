@@ -8,10 +8,13 @@
 namespace enamel::cohesive {
 
 double Law::delta0() const { return sigma0 / k; }
-double Law::delta1() const { return Gamma / sigma0; }
-double Law::deltaf() const { return delta1() + delta0(); }
+double Law::softeningLength() const { return softeningOverDelta0 * delta0(); }
+// delta1 = Gamma/sigma0 + (delta0 - L)/2: with L = delta0 (the default) the correction is +0.0 exactly, so
+// delta1 = Gamma/sigma0 bit for bit.
+double Law::delta1() const { return Gamma / sigma0 + 0.5 * (delta0() - softeningLength()); }
+double Law::deltaf() const { return delta1() + softeningLength(); }
 
-Law makeLaw(double k, double sigma0, double Gamma) {
+Law makeLaw(double k, double sigma0, double Gamma, double softeningOverDelta0) {
   // !(x > 0) also rejects NaN.
   if (!(k > 0.0)) throw std::invalid_argument("cohesive law: stiffness k must be > 0, got " + std::to_string(k));
   if (!(sigma0 > 0.0))
@@ -23,18 +26,24 @@ Law makeLaw(double k, double sigma0, double Gamma) {
     throw std::invalid_argument("cohesive law: fracture energy Gamma = " + std::to_string(Gamma) +
                                 " must be >= sigma0^2/k = " + std::to_string(sigma0 * sigma0 / k) +
                                 " (plateau end delta1 = Gamma/sigma0 below elastic limit delta0 = sigma0/k)");
-  return Law{k, sigma0, Gamma};
+  // delta1 >= delta0  <=>  L/delta0 <= 2 G - 1 (the triangle at equality; slack for round-off in G).
+  const double maxSoftening = 2.0 * Gamma * k / (sigma0 * sigma0) - 1.0;
+  if (!(softeningOverDelta0 > 0.0) || softeningOverDelta0 > maxSoftening * (1.0 + 1e-12))
+    throw std::invalid_argument("cohesive law: softening_over_delta0 = " + std::to_string(softeningOverDelta0) +
+                                " must be in (0, 2 Gamma k/sigma0^2 - 1] = (0, " + std::to_string(maxSoftening) +
+                                "] (plateau end delta1 below elastic limit delta0)");
+  return Law{k, sigma0, Gamma, softeningOverDelta0};
 }
 
 // T(lambda) = k lambda                          for lambda <= delta0
 //           = sigma0                            for delta0 < lambda <= delta1
-//           = sigma0 (deltaf - lambda)/delta0   for delta1 < lambda < deltaf   (deltaf - delta1 = delta0)
+//           = sigma0 (deltaf - lambda)/L        for delta1 < lambda < deltaf   (L = deltaf - delta1; default delta0)
 //           = 0                                 for lambda >= deltaf
 double envelopeTraction(const Law& law, double lambda) {
   const double d0 = law.delta0(), d1 = law.delta1(), df = law.deltaf();
   if (lambda <= d0) return law.k * lambda;
   if (lambda <= d1) return law.sigma0;
-  if (lambda < df) return law.sigma0 * (df - lambda) / d0;
+  if (lambda < df) return law.sigma0 * (df - lambda) / law.softeningLength();
   return 0.0;
 }
 

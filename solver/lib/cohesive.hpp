@@ -8,17 +8,25 @@ namespace enamel::cohesive {
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
-// Symmetric trapezoid fully set by (k, sigma0, Gamma): elastic to delta0 = sigma0/k, plateau to
-// delta1 = Gamma/sigma0, linear to zero at deltaf = delta1 + delta0 (area = Gamma). Requires delta1 >= delta0.
+// Trapezoid set by (k, sigma0, Gamma) and its softening length: elastic to delta0 = sigma0/k, plateau to
+// delta1, linear to zero at deltaf = delta1 + L, L = softeningOverDelta0 * delta0 (case key
+// softening_over_delta0). Area = Gamma:
+//   Gamma = sigma0 delta0/2 + sigma0 (delta1 - delta0) + sigma0 L/2  =>  delta1 = Gamma/sigma0 + (delta0 - L)/2.
+// Default L = delta0 (the symmetric trapezoid of DESIGN.md 3): delta1 = Gamma/sigma0, deltaf = delta1 + delta0,
+// and the same floating-point numbers as before the key (delta0 - 1.0*delta0 = 0 exactly). Requires
+// delta1 >= delta0, i.e. L/delta0 <= 2 G - 1 with G = Gamma k/sigma0^2 (equality: the triangle, no plateau).
 struct Law {
   double k, sigma0, Gamma;
+  double softeningOverDelta0 = 1.0;  // L/delta0 = (deltaf - delta1)/delta0
   double delta0() const;
+  double softeningLength() const;  // L = softeningOverDelta0 * delta0
   double delta1() const;
   double deltaf() const;
 };
 
-// throws std::invalid_argument (message names the quantity) if k, sigma0, Gamma not > 0 or Gamma < sigma0^2/k.
-Law makeLaw(double k, double sigma0, double Gamma);
+// throws std::invalid_argument (message names the quantity) if k, sigma0, Gamma not > 0, Gamma < sigma0^2/k,
+// or softeningOverDelta0 outside (0, 2 G - 1] (G = Gamma k/sigma0^2; 1e-12 relative slack for round-off in G).
+Law makeLaw(double k, double sigma0, double Gamma, double softeningOverDelta0 = 1.0);
 
 // Monotonic envelope T(lambda) of the effective traction for effective separation lambda >= 0.
 double envelopeTraction(const Law& law, double lambda);

@@ -146,15 +146,32 @@ namespace {
       gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]));
   return beam::maxTensileStressOfRows(mat.section, fl);
 }
+
+// The alternative definitions of case key rod_stress (beam.hpp RodStress); axial_bending is stressOfBeam above.
+// principal reads one more row of K_local T, the torque.
+double stressOfBeamAlternative(const Model& m, const Materials& mat, const VecX& q, int e) {
+  const int ply = m.rodPly[m.beamRod[e]];
+  const beam::Vec12 ue = gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
+  const beam::Vec5 fl = mat.beamStressOperator[ply].lazyProduct(ue);
+  if (mat.rodStress == beam::RodStress::Axial) return beam::axialStressOfRows(mat.section, fl);
+  return beam::principalStressOfRows(mat.section, fl, mat.beamTorsionOperator[ply].dot(ue));
+}
 }  // namespace
 
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
+  if (mat.rodStress != beam::RodStress::AxialBending) return stressOfBeamAlternative(m, mat, q, e);
   return stressOfBeam(m, mat, q, e);
 }
 
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                  const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio) {
   ratio.resize(m.numBeams());
+  if (mat.rodStress != beam::RodStress::AxialBending) {  // rod_stress alternatives: off the default's loop
+#pragma omp parallel for schedule(static)
+    for (int e = 0; e < m.numBeams(); ++e)
+      ratio[e] = beamBroken[e] ? 0.0 : stressOfBeamAlternative(m, mat, q, e) / mat.beamStrength[e];
+    return;
+  }
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < m.numBeams(); ++e) ratio[e] = beamBroken[e] ? 0.0 : stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
 }

@@ -44,7 +44,8 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 /// q += dt v over all DOF (threaded): the explicit schemes' position update.
 void advancePositions(VecX& q, const VecX& v, double dt);
 
-/// Largest tensile stress of rod element e (units of E_r): beam::maxTensileStress of its local end forces.
+/// Stress of rod element e for the brittle check (units of E_r), as case key rod_stress defines it (default
+/// beam::maxTensileStress of its local end forces).
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e);
 /// Stress ratio sigma / sigma_ru of every intact rod element (0 for deleted ones): the deletion check.
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,

@@ -214,6 +214,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "added_rotary_inertia", sim.integrator->addedRotaryInertia());
       attr(g.id, "linear_solver", p.linear_solver);
       attr(g.id, "deletion_rule", p.deletion_rule);
+      attr(g.id, "rod_stress", p.rod_stress);
       attr(g.id, "seed", static_cast<long>(p.seed));
       attr(g.id, "strength_generator", kStrengthGenerator);
       attr(g.id, "status", rec.status);
@@ -240,6 +241,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "Gamma_i", Gamma);
       attr(g.id, "sigma0", p.sigma0());
       attr(g.id, "k", p.k());
+      attr(g.id, "softening_over_delta0", p.softening_over_delta0);
       attr(g.id, "sigma_ru_mean", p.sigma_ru());
       const StaticStart& st = rec.staticStart;
       attr(g.id, "static_start", st.fraction);

@@ -38,7 +38,7 @@ beam::Section sectionOf(const CaseParams& p) {
 // Unbreakable interfaces (verification runs) keep the elastic branch however far they open.
 cohesive::Law lawOf(const CaseParams& p) {
   if (!p.interfaces_breakable) return cohesive::Law{p.k(), 1e300, 1e300};
-  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma());
+  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma(), p.softening_over_delta0);
 }
 
 // Add (sign x) a 12x12 element matrix into a triplet list / an existing sparse pattern.
@@ -150,6 +150,7 @@ Simulation::Simulation(const CaseParams& p)
   mat.law = lawOf(p);
   mat.rodsBreakable = p.rods_breakable;
   mat.deletionRule = p.deletion_rule;
+  mat.rodStress = beam::parseRodStress(p.rod_stress);
   const beam::Section& section = mat.section;
 
   // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
@@ -179,6 +180,7 @@ Simulation::Simulation(const CaseParams& p)
     mat.beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
     mat.beamStressOperator.emplace_back();
     for (int r = 0; r < 5; ++r) mat.beamStressOperator.back().row(r) = mat.beamLocalForceOperator.back().row(beam::kStressRows[r]);
+    mat.beamTorsionOperator.push_back(mat.beamLocalForceOperator.back().row(beam::kTorsionRow));
   }
   // Rod elements cut by the pre-crack carry no stiffness but keep their material's mass, lumped at their
   // nodes (as a deleted element does), so a rod end isolated by the cut is not massless. Assembled from

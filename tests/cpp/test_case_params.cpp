@@ -499,3 +499,29 @@ TEST(CaseParams, SetValuesThatTomlCannotHoldAreRefusedOrEscaped) {
     auto keysPart = [](const std::string& t) { return t.substr(t.find("# --- physics")); };  // comments differ
     EXPECT_EQ(keysPart(again.tomlText), keysPart(p.tomlText));
 }
+
+// softening_over_delta0: allowed (0, 2 Gamma_k_over_sigma0sq - 1]; the upper bound depends on another key, so
+// it is a cross-key check, still one line naming the key, the value and the allowed range.
+TEST(CaseParams, SofteningOverDelta0RangeDependsOnGamma) {
+    EXPECT_EQ(parse("").softening_over_delta0, 1.0);
+    EXPECT_EQ(parse("softening_over_delta0 = 5\n").softening_over_delta0, 5.0);  // the triangle at G = 3
+    EXPECT_EQ(parse("softening_over_delta0 = 15\nGamma_k_over_sigma0sq = 8\n").softening_over_delta0, 15.0);
+    const auto high = caseErrorOf([] { parse("", "", {"softening_over_delta0=6"}); });
+    EXPECT_EQ(high.exitCode, exit_code::out_of_range);
+    expectMessage(high, {"'softening_over_delta0'", "= 6", "(0, 5]", "Gamma_k_over_sigma0sq = 3"});
+    const auto zero = caseErrorOf([] { parse("softening_over_delta0 = 0\n"); });
+    EXPECT_EQ(zero.exitCode, exit_code::out_of_range);
+    expectMessage(zero, {"'softening_over_delta0'", "= 0", "(0, "});
+    const auto nan = caseErrorOf([] { parse("softening_over_delta0 = nan\n"); });
+    EXPECT_EQ(nan.exitCode, exit_code::out_of_range);
+    expectMessage(nan, {"'softening_over_delta0'", "nan"});
+}
+
+TEST(CaseParams, RodStressChoices) {
+    EXPECT_EQ(parse("").rod_stress, "axial_bending");
+    EXPECT_EQ(parse("", "", {"rod_stress=principal"}).rod_stress, "principal");
+    EXPECT_EQ(parse("rod_stress = \"axial\"\n").rod_stress, "axial");
+    const auto e = caseErrorOf([] { parse("rod_stress = \"von_mises\"\n"); });
+    EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+    expectMessage(e, {"'rod_stress'", "\"von_mises\"", "\"axial_bending\"", "\"axial\"", "\"principal\""});
+}

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -357,4 +359,144 @@ TEST(Cohesive, PackInSliceRefusesAnInterfaceAcrossSlices) {
   EXPECT_THROW(packInSlice(InterfaceGeometry{makeFrame(xB - xA), mid - xA, mid - xB, 0.1}), std::invalid_argument);
   const Vec3 yB(0, 1, 0), off(0.3, 0.5, 0);  // an arm with an x part
   EXPECT_THROW(packInSlice(InterfaceGeometry{makeFrame(yB - xA), off - xA, off - yB, 0.1}), std::invalid_argument);
+}
+
+// --- softening_over_delta0: the trapezoid's shape at fixed Gamma ---------------------------------------------
+
+namespace {
+
+// The law before the key, written out (delta1 = Gamma/sigma0, deltaf = delta1 + delta0, drop over delta0).
+struct TodaysLaw {
+  double k, sigma0, Gamma;
+  double d0() const { return sigma0 / k; }
+  double d1() const { return Gamma / sigma0; }
+  double df() const { return d1() + d0(); }
+  double envelope(double lambda) const {
+    if (lambda <= d0()) return k * lambda;
+    if (lambda <= d1()) return sigma0;
+    if (lambda < df()) return sigma0 * (df() - lambda) / d0();
+    return 0.0;
+  }
+  double secant(double lambdaMax) const {
+    if (k * lambdaMax <= sigma0) return k;
+    if (lambdaMax >= df()) return 0.0;
+    return envelope(lambdaMax) / lambdaMax;
+  }
+};
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+TEST(Cohesive, SofteningShapeKeepsAreaGamma) {
+  // G = 3: allowed L/delta0 in (0, 5]; 1 = today's trapezoid, 5 = the triangle.
+  for (double s : {0.05, 0.2, 0.5, 1.0, 2.5, 4.0, 5.0}) {
+    const Law L = makeLaw(0.1, 1e-4, 3e-7, s);
+    EXPECT_NEAR(L.deltaf() - L.delta1(), s * L.delta0(), kRoundoff * L.deltaf()) << s;
+    EXPECT_GE(L.delta1(), L.delta0() * (1.0 - kRoundoff)) << s;
+    const double area = 0.5 * L.sigma0 * L.delta0() + L.sigma0 * (L.delta1() - L.delta0()) +
+                        0.5 * L.sigma0 * (L.deltaf() - L.delta1());
+    EXPECT_NEAR(area, L.Gamma, kRoundoff * L.Gamma) << s;
+    // The work of a monotonic opening (trapezoid rule, exact on each linear leg) is Gamma, in every mode.
+    for (const Vec3& e : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.6, -0.48, 0.64).normalized()}) {
+      double lambdaMax = 0.0;
+      EXPECT_NEAR(monotonicWork(L, e, lambdaMax), L.Gamma, kWorkTol * L.Gamma) << s;
+      EXPECT_TRUE(isFailed(L, lambdaMax)) << s;
+      EXPECT_NEAR(dissipatedEnergyDensity(L, lambdaMax), L.Gamma, 1e-12 * L.Gamma) << s;
+    }
+    // Continuity of the envelope at each kink.
+    const double eps = 1e-9 * L.deltaf();
+    const double slope = std::max(L.k, L.sigma0 / L.softeningLength());
+    for (double kink : {L.delta0(), L.delta1(), L.deltaf()})
+      EXPECT_NEAR(envelopeTraction(L, kink + eps), envelopeTraction(L, kink), 2.0 * slope * eps) << s << " " << kink;
+  }
+}
+
+TEST(Cohesive, DefaultSofteningIsTodaysLawBitForBit) {
+  // Several (k, sigma0, Gamma), among them the solver's defaults (Er/kd 10, delta0/d 0.1, G 3 and 8), and
+  // lambdas across every branch and at the kinks: every quantity equal bit for bit.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.3);
+  const std::vector<std::array<double, 3>> laws = {
+      {0.1, 0.01, 3 * 1e-4 / 0.1}, {0.1, 0.01, 8 * 1e-4 / 0.1}, {0.1, 1e-4, 3e-7}, {0.05, 0.005, 7.3e-4},
+      {1e-3, 2e-4, 4e-5 * 1.7}, {0.2, 0.03, 0.03 * 0.03 / 0.2}};
+  for (const auto& [k, sigma0, Gamma] : laws) {
+    const Law L = makeLaw(k, sigma0, Gamma);  // default softening_over_delta0 = 1
+    const Law L1 = makeLaw(k, sigma0, Gamma, 1.0);
+    const TodaysLaw T{k, sigma0, Gamma};
+    EXPECT_TRUE(sameBits(L.delta0(), T.d0()) && sameBits(L1.delta0(), T.d0()));
+    EXPECT_TRUE(sameBits(L.delta1(), T.d1()) && sameBits(L1.delta1(), T.d1())) << L.delta1() << " " << T.d1();
+    EXPECT_TRUE(sameBits(L.deltaf(), T.df()) && sameBits(L1.deltaf(), T.df())) << L.deltaf() << " " << T.df();
+    std::vector<double> lambdas = {0.0, T.d0(), T.d1(), T.df(), std::nextafter(T.d1(), 1.0), std::nextafter(T.df(), 0.0)};
+    for (int i = 0; i < 2000; ++i) lambdas.push_back(u(rng) * T.df());
+    for (double lambda : lambdas) {
+      EXPECT_TRUE(sameBits(envelopeTraction(L1, lambda), T.envelope(lambda))) << lambda;
+      EXPECT_TRUE(sameBits(secantStiffness(L1, lambda), T.secant(lambda))) << lambda;
+      const Vec3 opening = lambda * Vec3(0.6, -0.48, 0.64).normalized();
+      double hNew = 0.3 * lambda, hOld = 0.3 * lambda;
+      const Vec3 tNew = computeTraction(L1, opening, hNew);
+      // Today's computeTraction: S(lambdaMax) (<dn>_+, dt1, dt2) + (k min(dn, 0), 0, 0).
+      hOld = std::max(hOld, effectiveSeparation(opening));
+      const double S = T.secant(hOld);
+      const Vec3 tOld(S * std::max(opening(0), 0.0) + k * std::min(opening(0), 0.0), S * opening(1), S * opening(2));
+      for (int c = 0; c < 3; ++c) EXPECT_TRUE(sameBits(tNew(c), tOld(c))) << lambda;
+      EXPECT_TRUE(sameBits(hNew, hOld));
+    }
+  }
+}
+
+TEST(Cohesive, TriangleLimitHasNoPlateau) {
+  // L/delta0 = 2G - 1: delta1 = delta0, peak sigma0 at delta0, linear to zero at deltaf = 2 Gamma/sigma0.
+  for (double G : {1.0, 3.0, 8.0}) {
+    const double k = 0.1, sigma0 = 0.01, Gamma = G * sigma0 * sigma0 / k;
+    const Law L = makeLaw(k, sigma0, Gamma, 2.0 * G - 1.0);
+    EXPECT_NEAR(L.delta1(), L.delta0(), kRoundoff * L.deltaf()) << G;
+    EXPECT_NEAR(L.deltaf(), 2.0 * Gamma / sigma0, kRoundoff * L.deltaf()) << G;
+    EXPECT_NEAR(envelopeTraction(L, L.delta0()), sigma0, kRoundoff * sigma0) << G;
+    for (double f : {0.1, 0.5, 0.9}) {
+      const double lambda = L.delta0() + f * (L.deltaf() - L.delta0());
+      EXPECT_NEAR(envelopeTraction(L, lambda), sigma0 * (1.0 - f), 1e-10 * sigma0) << G << " " << f;
+    }
+    double lambdaMax = 0.0;
+    EXPECT_NEAR(monotonicWork(L, Vec3(0, 0, 1), lambdaMax), Gamma, kWorkTol * Gamma) << G;
+  }
+  // G = 1: the only allowed shape is the triangle, L/delta0 = 1 (today's law at G = 1).
+  EXPECT_NO_THROW(makeLaw(0.1, 0.01, 0.01 * 0.01 / 0.1, 1.0));
+  EXPECT_THROW(makeLaw(0.1, 0.01, 0.01 * 0.01 / 0.1, 1.01), std::invalid_argument);
+}
+
+TEST(Cohesive, SofteningIsMonotone) {
+  // Past delta0 the envelope never rises and the secant stiffness never rises, for every shape.
+  for (double s : {0.05, 0.2, 1.0, 3.0, 5.0}) {
+    const Law L = makeLaw(0.1, 1e-4, 3e-7, s);
+    double prevT = envelopeTraction(L, L.delta0()), prevS = secantStiffness(L, L.delta0());
+    for (int i = 1; i <= 4000; ++i) {
+      const double lambda = L.delta0() + (1.2 * L.deltaf() - L.delta0()) * i / 4000.0;
+      const double T = envelopeTraction(L, lambda), S = secantStiffness(L, lambda);
+      EXPECT_LE(T, prevT) << s << " " << lambda;
+      EXPECT_LE(S, prevS) << s << " " << lambda;
+      EXPECT_GE(T, 0.0);
+      prevT = T, prevS = S;
+    }
+    double prevW = 0.0;
+    for (int i = 0; i <= 400; ++i) {
+      const double w = dissipatedEnergyDensity(L, 1.2 * L.deltaf() * i / 400.0);
+      EXPECT_GE(w, prevW) << s << " " << i;
+      prevW = w;
+    }
+  }
+}
+
+TEST(Cohesive, MakeLawRejectsBadSoftening) {
+  // G = 3: allowed (0, 5].
+  for (double s : {0.0, -1.0, 5.01, 100.0, std::numeric_limits<double>::quiet_NaN()}) {
+    try {
+      makeLaw(0.1, 1e-4, 3e-7, s);
+      ADD_FAILURE() << "expected std::invalid_argument for " << s;
+    } catch (const std::invalid_argument& ex) {
+      EXPECT_NE(std::string(ex.what()).find("softening_over_delta0"), std::string::npos) << ex.what();
+    }
+  }
+  EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7, 5.0));
+  EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7, 1e-6));
 }
