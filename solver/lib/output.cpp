@@ -75,6 +75,9 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"inelastic_interfaces", &M::inelasticInterfaces, "count"},
       {"rate_multiplier", &M::rateMultiplier, "-",
        "phi: the adaptive loading rate's multiplier of v_app (dU/dt = phi U'(tau); 1 when rate_adapt_max = 1)"},
+      {"inelastic_reach_over_d", &M::inelasticReach, "d",
+       "largest distance |y - y_crack| from the crack plane of an interface past delta0 or a broken rod element "
+       "(midpoints of their nodes' reference positions); h_s/2 is the loaded edge"},
   };
   return columns;
 }

@@ -23,6 +23,7 @@ volatile std::sig_atomic_t gStopSignal = 0;
 constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
 constexpr double kBalanceFail = 0.25;      // ... above this: the run is unstable, stop
 constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
+constexpr double kEdgeWarnDistance = 2.0;  // d: the inelastic zone this near the loaded edges: warning
 constexpr double kBalanceMinWork = 0.1;    // x Gamma_i B d: the balance error is checked once this much work was done
 
 std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0, double e = 0) {
@@ -172,6 +173,15 @@ class RunLoop {
       rec_.warnedKinetic = true;
       rec_.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
                                   kineticRatio, s.step, kKineticWarn));
+    }
+    // The inelastic zone near the loaded edges: the R-curve depends on the specimen's height from here on.
+    const double halfHeight = 0.5 * sim_.model.h_s;
+    if (!rec_.warnedEdge && r.inelasticReach > halfHeight - kEdgeWarnDistance) {
+      rec_.warnedEdge = true;
+      rec_.warnings.push_back(fmt("inelastic zone reached %.3g d from the crack plane at step %.0f (Delta_a %.3g d), "
+                                  "within %.2g d of the loaded edges at h_s/2 = %.3g d: from here on the R-curve "
+                                  "depends on the specimen's height (a larger h_s_over_d gives the size-independent one)",
+                                  r.inelasticReach, s.step, s.crackAdvance, kEdgeWarnDistance, halfHeight));
     }
     return true;
   }

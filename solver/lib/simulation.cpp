@@ -466,6 +466,21 @@ int Simulation::countFailedInterfaces() const {
   return n;
 }
 
+// How far the inelastic zone reaches from the crack plane: the largest |y - y_crack| over the interfaces past
+// delta0 and the deleted rod elements, each at the midpoint of its two nodes' reference positions (0 while
+// everything is elastic). The runner warns when it comes near the loaded edges (the R-curve then depends on
+// the specimen's height: studies/scene/README.md).
+double Simulation::inelasticReach() const {
+  const Model& m = model;
+  auto distance = [&](const std::array<int, 2>& n) { return std::abs(0.5 * (m.X[n[0]].y() + m.X[n[1]].y()) - m.yCrack); };
+  double reach = 0;
+  for (int i = 0; i < m.numInterfaces(); ++i)
+    if (cohesive::isInelastic(materials.law, state.lambdaMax[i])) reach = std::max(reach, distance(m.ifaceNodes[i]));
+  for (int e = 0; e < m.numBeams(); ++e)
+    if (state.beamBroken[e]) reach = std::max(reach, distance(m.beamNodes[e]));
+  return reach;
+}
+
 int Simulation::countInelasticInterfaces() const {
   int n = 0;
   for (double lm : state.lambdaMax) n += cohesive::isInelastic(materials.law, lm);
@@ -597,6 +612,7 @@ Measurement Simulation::measure() const {
   r.brokenBeams = state.brokenBeams();
   r.failedInterfaces = countFailedInterfaces();
   r.inelasticInterfaces = countInelasticInterfaces();
+  r.inelasticReach = inelasticReach();
   double P = 0;
   for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) P += state.reaction[i] * ops.prescribedShape[i];
   r.load = P;

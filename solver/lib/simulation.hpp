@@ -22,6 +22,7 @@ struct Measurement {
   int brokenBeams = 0, failedInterfaces = 0, inelasticInterfaces = 0;
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)
   double rateMultiplier = 1;  // phi of the adaptive loading rate (loading_rate.hpp; 1 when off)
+  double inelasticReach = 0;  // largest |y - y_crack| of an inelastic interface or broken rod element (d)
 };
 
 /// What a static elastic start (case key static_start, Simulation::startFromStaticElastic) did; plain data,
@@ -92,6 +93,7 @@ class Simulation {
   double fractureEnergyOfInterfaces() const;
   int countFailedInterfaces() const;
   int countInelasticInterfaces() const;
+  double inelasticReach() const;
 
  private:
   std::vector<double> beamStressRatio_;  // scratch: sigma / sigma_ru per rod element
