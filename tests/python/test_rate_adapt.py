@@ -75,7 +75,9 @@ def test_each_interval_follows_the_rule(adaptive):
 def test_adaptive_run_stays_quasi_static_and_balanced(adaptive):
     meta = adaptive["meta"]
     assert meta["status"] == "completed"
-    assert meta["warnings"] == "", meta["warnings"]   # neither the energy balance nor the kinetic ratio warned
+    # neither the energy balance nor the kinetic ratio warned (the size warning is about the ci specimen's height)
+    warned = [w for w in meta["warnings"].splitlines() if w and not w.startswith("inelastic zone reached")]
+    assert warned == [], meta["warnings"]
     assert meta["max_kinetic_over_strain_while_growing"] < KINETIC_WARN
 
 
