@@ -174,13 +174,13 @@ class RunLoop {
       rec_.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
                                   kineticRatio, s.step, kKineticWarn));
     }
-    // The inelastic zone near the loaded edges: the R-curve depends on the specimen's height from here on.
+    // The inelastic zone near the loaded edges: the R-curve may depend on the specimen's height.
     const double halfHeight = 0.5 * sim_.model.h_s;
     if (!rec_.warnedEdge && r.inelasticReach > halfHeight - kEdgeWarnDistance) {
       rec_.warnedEdge = true;
       rec_.warnings.push_back(fmt("inelastic zone reached %.3g d from the crack plane at step %.0f (Delta_a %.3g d), "
-                                  "within %.2g d of the loaded edges at h_s/2 = %.3g d: from here on the R-curve "
-                                  "depends on the specimen's height (a larger h_s_over_d gives the size-independent one)",
+                                  "within %.2g d of the loaded edges at h_s/2 = %.3g d: the specimen is not large "
+                                  "against it, so the R-curve may depend on h_s_over_d (compare a taller specimen)",
                                   r.inelasticReach, s.step, s.crackAdvance, kEdgeWarnDistance, halfHeight));
     }
     return true;
