@@ -432,7 +432,7 @@ def convergence(rows, pairs: dict | None = None) -> list[dict]:
             p = pairs.get((run_key(a), run_key(ref)))
             if p is None:
                 return math.nan, math.nan
-            notes.append(f"{what} from committed data/pairs.csv (runs of {p[2]})")
+            notes.append(f"{what} (runs of {p[2]})")
             return p[0], p[1]
 
         coarse, fine = get("red", 0.3, G), get("red", 0.15, G)
@@ -456,7 +456,7 @@ def convergence(rows, pairs: dict | None = None) -> list[dict]:
                         size_l2=size_l2, l2_ci_red=l2_ci_red,
                         l2_red_big=l2_red_big, largest=sizes[-1] if sizes else "-",
                         R_ss_largest=largest["R_ss"] if largest else math.nan, status=status,
-                        note="; ".join(notes)))
+                        note=", ".join(notes)))
     return out
 
 
@@ -694,7 +694,8 @@ def report(args) -> None:
                  f"{pct(c['mesh_dRss'])} / {pct(c['size_dRss'])} |")
     notes = [f"G = {c['G']:g}: {c['note']}" for c in conv if c["note"]]
     if notes:
-        L += ["", "Distances not computed from curves (one run's curve was not kept): " + "; ".join(notes) + "."]
+        L += ["", "Distances taken from the committed `data/pairs.csv` (a run of the pair has no kept curve, so "
+              "the pair's distance is the one its own session measured): " + "; ".join(notes) + "."]
     L += ["", "## Selection (the README's rule, applied as written)", ""]
     if sel:
         L.append(f"**Selected: G = {sel['G']:g}** (converged; theta30 (21.4, 10) R_ss {sel['R_ss_largest']:.2f} at "
