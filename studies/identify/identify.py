@@ -6,8 +6,11 @@ cases for the candidate values, and writes the report (studies/identify/results.
 The plan, the convergence criterion and the selection rule are in studies/identify/README.md, written before
 any run.
 
+Every completed run is also kept as a small committed record in studies/identify/data/ (metrics, R-curve,
+broken-element positions); the report reads a run from its folder when present, else from that record.
+
 Every run goes through the solver with --resume and a checkpoint interval, niced, one thread each, at most
---jobs at once; a run whose result.h5 exists is skipped, so the command can be stopped (Ctrl-C, SIGKILL) and
+--jobs at once; a run whose result.h5 exists (or, except with --only, whose completed record is committed) is skipped, so the command can be stopped (Ctrl-C, SIGKILL) and
 re-issued at any time. Runs: runs/identify/<size>_he<h_e>_G<G>/<case>/.
 
 Stages (default "ap"; each only as far as --stop-starting allows):
@@ -25,6 +28,7 @@ from __future__ import annotations
 import argparse
 import csv
 import datetime
+import json
 import math
 import os
 import pathlib
@@ -60,6 +64,11 @@ PRESET = "reduced"
 PAPER_RSS = 7.0        # the rule's target (Sec. 3); Sec. 5 gives ~8 for the same case (reported, not used)
 CONVERGED_L2 = 0.05    # the paper's "did not affect the calculation results", read as 5% relative L2
 RUNS = ROOT / "runs" / "identify"
+# Committed per-run data (README "Changes to the plan" 6): runs/ does not survive a session, so every completed
+# run's metrics, R-curve and broken-element positions are kept here (one small JSON file per run) and the report
+# uses them for every run whose folder is absent.
+DATA = HERE / "data"
+CURVE_DIGITS = 10      # significant digits of the stored R-curves (the L2 distances are reproduced to ~1e-9)
 
 
 def run_dir(size: str, he: float, G: float, case: str, runs: pathlib.Path = RUNS) -> pathlib.Path:
@@ -151,16 +160,113 @@ def metrics(size, he, G, case, runs=RUNS) -> dict | None:
                R_end=float(r.R[-1]) if r.R.size else math.nan,
                broken_rods=r.broken_rods, da_first_rod=r.da_first_rod_fracture,
                E_T=ET, l_over_d=ET * er_kd * G, delta_f_over_d=(G + 1) * delta0,
-               wall_s=r.wall_time_s, path=str(path.relative_to(ROOT)))
+               wall_s=r.wall_time_s,
+               path=str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path))
     row.update(rod_break_positions(r))
-    row["_r"] = r
+    row.update(da=np.asarray(r.da, float), R=np.asarray(r.R, float), breaks=break_points(r),
+               theta_D=float(r.param("theta_D")), sigma_ru=float(r.param("sigma_ru_over_sigma0")),
+               source="run folder",
+               session=f"{str(r.meta.get('written_utc', ''))[:16].replace('T', ' ')} UTC, solver "
+                       f"{str(r.meta.get('git_hash', '?'))[:12]}")
     return row
 
 
+def break_points(r) -> dict | None:
+    """What breaks.png needs of a run: the midpoints and plies of the deleted rod elements (final frame) and the
+    crisscross lattice's origin."""
+    g = r.geometry
+    if g is None or not r.frames:
+        return None
+    b = np.flatnonzero(r.frames[-1].beam_broken > 0)
+    mid = 0.5 * (g.node_position[g.beam_nodes[b, 0]] + g.node_position[g.beam_nodes[b, 1]])
+    return dict(x_crisscross=float(g.attrs["x_crisscross"]), y_crack_plane=float(g.attrs["y_crack_plane"]),
+                w_s=float(g.attrs["w_s"]), x=[round(float(v), 6) for v in mid[:, 0]],
+                y=[round(float(v), 6) for v in mid[:, 1]], ply=[int(v) for v in g.node_ply[g.beam_nodes[b, 0]]])
+
+
+# --- committed data: one JSON file per run (studies/identify/data/) -----------------------------------------------
+ROW_KEYS = ["size", "w_s", "h_s", "h_e", "G", "case", "status", "da_max", "R_init", "R_ss", "R_m", "R_at3", "R_end",
+            "broken_rods", "da_first_rod", "xx_offset_median", "xx_offset_mean", "xx_offset_near_median",
+            "sawtooth_period", "x_breaks", "E_T", "l_over_d", "delta_f_over_d", "wall_s"]
+
+
+def data_path(size: str, he: float, G: float, case: str, data: pathlib.Path = DATA) -> pathlib.Path:
+    return data / f"{size}_he{he:g}_G{G:g}__{case}.json"
+
+
+def _num(v):
+    return None if isinstance(v, float) and math.isnan(v) else v
+
+
+def _sig(v: float) -> float:
+    return float(f"{v:.{CURVE_DIGITS}g}")
+
+
+def store(m: dict, data: pathlib.Path = DATA) -> pathlib.Path:
+    """Write (or replace) the committed record of a run read from its folder. A record of an earlier run of the
+    same key is kept in "previous" (its metrics and session), so a re-run never loses what was measured."""
+    path = data_path(m["size"], m["h_e"], m["G"], m["case"], data)
+    previous = []
+    if path.is_file():
+        old = json.loads(path.read_text())
+        if old.get("session") == m["session"]:
+            previous = old.get("previous", [])
+        else:
+            previous = old.get("previous", []) + [{"session": old.get("session"), "metrics": old.get("metrics")}]
+    rec = {"session": m["session"],
+           "metrics": {k: _num(m[k]) for k in ROW_KEYS},
+           "theta_D": m["theta_D"], "sigma_ru_over_sigma0": m["sigma_ru"],
+           "rcurve": {"da_over_d": [_sig(v) for v in m["da"]], "R_over_Gamma": [_sig(v) for v in m["R"]]},
+           "breaks": m["breaks"], "previous": previous}
+    data.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(rec, indent=1, allow_nan=False) + "\n")
+    return path
+
+
+def stored(size: str, he: float, G: float, case: str, data: pathlib.Path = DATA) -> dict | None:
+    """A run's row from its committed record (None: no record). Records of the first session (runs made before the
+    data were kept) hold the metrics only: no R-curve (da/R None) and no broken-element positions."""
+    path = data_path(size, he, G, case, data)
+    if not path.is_file():
+        return None
+    rec = json.loads(path.read_text())
+    row = {k: (math.nan if v is None else v) for k, v in rec["metrics"].items()}
+    row["x_breaks"] = row.get("x_breaks") or ""
+    for k in ("broken_rods", "w_s", "h_s"):
+        row[k] = int(row[k])
+    rc = rec.get("rcurve")
+    row.update(da=np.asarray(rc["da_over_d"], float) if rc else None,
+               R=np.asarray(rc["R_over_Gamma"], float) if rc else None,
+               breaks=rec.get("breaks"), theta_D=float(rec["theta_D"]), sigma_ru=float(rec["sigma_ru_over_sigma0"]),
+               R_at_stored=rec.get("R_at", {}), source="committed data", session=rec["session"],
+               path=str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path))
+    return row
+
+
+def row_for(size, he, G, case, runs=RUNS, data=DATA) -> dict | None:
+    """The run's row from its folder when present (and not less complete than the committed record), else from
+    the committed data."""
+    m = metrics(size, he, G, case, runs)
+    if m and m["status"] == "completed":
+        return m
+    s = stored(size, he, G, case, data)
+    return s if s and (not m or s["status"] == "completed") else m
+
+
+def recorded(job: tuple, data: pathlib.Path = DATA) -> bool:
+    """Whether a completed run of this job is in the committed data (the stages skip it; --only re-runs it)."""
+    s = stored(*job, data=data)
+    return bool(s) and s["status"] == "completed"
+
+
+def has_curve(m: dict | None) -> bool:
+    return bool(m) and m["da"] is not None and m["da"].size >= 2
+
+
 def l2(a: dict | None, ref: dict | None) -> float:
-    if not a or not ref or a["_r"].da.size < 2 or ref["_r"].da.size < 2:
+    if not has_curve(a) or not has_curve(ref):
         return math.nan
-    return rcurve_rel_l2(ref["_r"].da, ref["_r"].R, a["_r"].da, a["_r"].R)
+    return rcurve_rel_l2(ref["da"], ref["R"], a["da"], a["R"])
 
 
 # --- the plan as jobs ------------------------------------------------------------------------------------------
@@ -186,13 +292,13 @@ def stage_jobs(stage: str, runs: pathlib.Path) -> list[tuple]:
 
 def candidates(runs: pathlib.Path, n: int = 2) -> list[float]:
     """The G values whose red (h_e 0.3) R_ss brackets 7 most closely; mesh-converged ones first when known."""
-    rows = {G: metrics("red", 0.3, G, MAIN_CASE, runs) for G in G_VALUES}
+    rows = {G: row_for("red", 0.3, G, MAIN_CASE, runs) for G in G_VALUES}
     rows = {G: m for G, m in rows.items() if m and m["status"] == "completed"}
     if not rows:
         return []
 
     def key(G):
-        fine = metrics("red", 0.15, G, MAIN_CASE, runs)
+        fine = row_for("red", 0.15, G, MAIN_CASE, runs)
         mesh = l2(rows[G], fine) if fine and fine["status"] == "completed" else math.nan
         unconverged = 1 if (not math.isnan(mesh) and mesh > CONVERGED_L2) else 0
         return (unconverged, abs(rows[G]["R_ss"] - PAPER_RSS))
@@ -220,6 +326,7 @@ def run_all(plan, args) -> None:
         late = bool(args.no_long_after) and datetime.datetime.now().strftime("%H:%M") >= args.no_long_after
         return [j for j in plan() if j not in busy and j not in tried
                 and not (run_dir(*j, runs=args.runs) / "result.h5").is_file()
+                and not (args.only is None and recorded(j, args.data))
                 and not (late and (j[0] == "big" or j[1] < 0.3))]
 
     while True:
@@ -260,19 +367,52 @@ def pct(v):
     return "-" if v is None or math.isnan(v) else f"{100 * v:.1f}%"
 
 
-def collect(runs) -> list[dict]:
-    rows = []
-    for d in sorted(runs.glob("*_he*_G*/*")):
+def collect(runs, data=DATA) -> list[dict]:
+    """Every run: from its folder under `runs` when present, else from its committed record under `data`."""
+    keys = set()
+    for d in runs.glob("*_he*_G*/*"):
         size, he, G = d.parent.name.split("_")
-        m = metrics(size, float(he[2:]), float(G[1:]), d.name, runs)
-        if m:
-            rows.append(m)
+        keys.add((size, float(he[2:]), float(G[1:]), d.name))
+    for f in data.glob("*_he*_G*__*.json"):
+        run, case = f.stem.split("__")
+        size, he, G = run.split("_")
+        keys.add((size, float(he[2:]), float(G[1:]), case))
+    rows = [m for m in (row_for(*k, runs=runs, data=data) for k in sorted(keys)) if m]
+    for m in rows:  # G as the plan writes it (3, not 3.0)
+        m["G"] = int(m["G"]) if float(m["G"]).is_integer() else m["G"]
     order = {s: i for i, s in enumerate(SIZE_ORDER)}
     rows.sort(key=lambda m: (m["case"] != MAIN_CASE, m["case"], m["G"], order.get(m["size"], 9), -m["h_e"]))
     return rows
 
 
-def convergence(rows) -> list[dict]:
+def run_key(m: dict) -> str:
+    return f"{m['size']}_he{m['h_e']:g}_G{m['G']:g}"
+
+
+def read_pairs(data: pathlib.Path = DATA) -> dict:
+    """Committed distances between two runs' R-curves that can no longer be computed (data/pairs.csv: the runs of
+    the first session, whose curves were not kept): (run, reference run) -> (L2, mean-R difference, session)."""
+    out = {}
+    f = data / "pairs.csv"
+    if f.is_file():
+        with open(f, newline="") as fh:
+            for r in csv.DictReader(fh):
+                out[(r["run"], r["ref"])] = (float(r["l2"]), float(r["dmean"]), r["session"])
+    return out
+
+
+def dmean(a: dict | None, ref: dict | None) -> float:
+    """Supplementary (not the rule): relative difference of mean R over the common Delta_a range."""
+    if not has_curve(a) or not has_curve(ref):
+        return math.nan
+    grid = np.linspace(max(a["da"][0], ref["da"][0]), min(a["da"][-1], ref["da"][-1]), 50)
+    ma, mr = np.interp(grid, a["da"], a["R"]).mean(), np.interp(grid, ref["da"], ref["R"]).mean()
+    return (ma - mr) / mr
+
+
+def convergence(rows, pairs: dict | None = None) -> list[dict]:
+    pairs = pairs or {}
+
     def get(size, he, G, case=MAIN_CASE):
         for m in rows:
             if (m["size"], m["h_e"], m["G"], m["case"]) == (size, he, G, case) and m["status"] == "completed":
@@ -281,36 +421,42 @@ def convergence(rows) -> list[dict]:
 
     out = []
     for G in sorted({m["G"] for m in rows if m["case"] == MAIN_CASE}):
+        notes = []
+
+        def dist(a, ref, what):
+            """(L2, mean-R difference) of a against ref: from the curves, else from a committed pair."""
+            if not a or not ref:
+                return math.nan, math.nan
+            if has_curve(a) and has_curve(ref):
+                return l2(a, ref), dmean(a, ref)
+            p = pairs.get((run_key(a), run_key(ref)))
+            if p is None:
+                return math.nan, math.nan
+            notes.append(f"{what} (runs of {p[2]})")
+            return p[0], p[1]
+
         coarse, fine = get("red", 0.3, G), get("red", 0.15, G)
         sizes = [s for s in SIZE_ORDER if get(s, 0.3, G)]
-        mesh = l2(coarse, fine)
+        mesh, mesh_drss = dist(coarse, fine, "mesh")
+        l2_ci_red, ci_red_drss = dist(get("ci", 0.3, G), get("red", 0.3, G), "ci/red")
+        l2_red_big, red_big_drss = dist(get("red", 0.3, G), get("big", 0.3, G), "red/big")
         if len(sizes) >= 2:
             small, large = sizes[-2], sizes[-1]
-            size_l2 = l2(get(small, 0.3, G), get(large, 0.3, G))
+            size_l2, size_drss = {"ci/red": (l2_ci_red, ci_red_drss), "red/big": (l2_red_big, red_big_drss),
+                                  "ci/big": dist(get("ci", 0.3, G), get("big", 0.3, G), "ci/big")}[f"{small}/{large}"]
             pair = f"{small}/{large}"
         else:
-            size_l2, pair = math.nan, "-"
-        l2_ci_red = l2(get("ci", 0.3, G), get("red", 0.3, G))
-        l2_red_big = l2(get("red", 0.3, G), get("big", 0.3, G))
+            size_l2, size_drss, pair = math.nan, math.nan, "-"
         largest = get(sizes[-1], 0.3, G) if sizes else None
         conv = (not math.isnan(mesh) and not math.isnan(size_l2) and mesh <= CONVERGED_L2
                 and size_l2 <= CONVERGED_L2)
         status = ("converged" if conv else
                   "not established" if math.isnan(mesh) or math.isnan(size_l2) else "not converged")
-        def drss(a, ref):  # supplementary (not the rule): mean R over the common Delta_a range, relative difference
-            if not a or not ref:
-                return math.nan
-            ra, rr = a["_r"], ref["_r"]
-            grid = np.linspace(max(ra.da[0], rr.da[0]), min(ra.da[-1], rr.da[-1]), 50)
-            ma, mr = np.interp(grid, ra.da, ra.R).mean(), np.interp(grid, rr.da, rr.R).mean()
-            return (ma - mr) / mr
-
-        mesh_drss = drss(coarse, fine)
-        size_drss = drss(get(sizes[-2], 0.3, G), get(sizes[-1], 0.3, G)) if len(sizes) >= 2 else math.nan
         out.append(dict(G=G, mesh_l2=mesh, mesh_dRss=mesh_drss, size_dRss=size_drss, size_pair=pair,
                         size_l2=size_l2, l2_ci_red=l2_ci_red,
                         l2_red_big=l2_red_big, largest=sizes[-1] if sizes else "-",
-                        R_ss_largest=largest["R_ss"] if largest else math.nan, status=status))
+                        R_ss_largest=largest["R_ss"] if largest else math.nan, status=status,
+                        note=", ".join(notes)))
     return out
 
 
@@ -376,8 +522,10 @@ def validation(rows, G) -> list[tuple[str, str, str]]:
         out.append(("6. no rod breaks before Delta_a = d/sin(theta_D) (2 d at 30, 3.86 d at 15)", s6,
                     verdict(ok6) + ("" if m["broken_rods"] else " (vacuous: no rod breaks)")))
     if hi:
-        r = hi["_r"]
-        R2, R4, R6 = (float(np.interp(a, r.da, r.R)) for a in (2, 4, 6))
+        if has_curve(hi):
+            R2, R4, R6 = (float(np.interp(a, hi["da"], hi["R"])) for a in (2, 4, 6))
+        else:  # a committed record without its curve: the values the first session's report gave
+            R2, R4, R6 = (float(hi["R_at_stored"].get(k, math.nan)) for k in ("2", "4", "6"))
         out.append(("7. theta30 (28.5, 10): R flat to ~4 d, rising after", f"R(2,4,6 d) = {R2:.2f}, {R4:.2f}, {R6:.2f}",
                     verdict(R4 - R2 < R6 - R4)))
     else:
@@ -389,16 +537,18 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
     made = []
     main = [m for m in rows if m["case"] == MAIN_CASE]
     panels = [("ci", 0.3), ("red", 0.3), ("red", 0.15), ("big", 0.3)]
+    missing = [m for m in main if not has_curve(m)]
+    nocurve = ("" if not missing else "\nnot drawn (committed without their curve, runs of the first session: "
+               "see data/session1/): " + ", ".join(f"{m['size']} h_e {m['h_e']:g} G {m['G']:g}" for m in missing))
     fig, axes = plt.subplots(1, 4, figsize=(16, 4.2), sharey=True)
     cmap = plt.get_cmap("viridis")
     for ax, (size, he) in zip(axes, panels):
         for m in main:
-            if (m["size"], m["h_e"]) != (size, he):
+            if (m["size"], m["h_e"]) != (size, he) or not has_curve(m):
                 continue
             i = G_VALUES.index(int(m["G"])) if int(m["G"]) in G_VALUES else 0
-            r = m["_r"]
             ls = "-" if m["status"] == "completed" else ":"
-            ax.plot(r.da, r.R, ls, color=cmap(i / (len(G_VALUES) - 1)), label=f"G = {m['G']:g} ({m['broken_rods']} rods)")
+            ax.plot(m["da"], m["R"], ls, color=cmap(i / (len(G_VALUES) - 1)), label=f"G = {m['G']:g} ({m['broken_rods']} rods)")
         ax.axhline(PAPER_RSS, color="k", ls="--", lw=0.8)
         w, h, _, _ = SIZES[size]
         ax.set_title(f"{size}: {w} x {h} d, h_e = {he} d")
@@ -407,31 +557,29 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
             ax.legend(fontsize=7)
     axes[0].set_ylabel(r"$R/\Gamma_i$")
     fig.suptitle(r"theta30 ($\sigma_{ru}/\sigma_0$ = 21.4, $E_r/kd$ = 10): R-curves per ductility G = "
-                 r"$\Gamma_i k/\sigma_0^2$ (dashed: paper $R_{ss}\approx 7$; dotted curves: unfinished runs)")
+                 r"$\Gamma_i k/\sigma_0^2$ (dashed: paper $R_{ss}\approx 7$; dotted curves: unfinished runs)" + nocurve)
     fig.tight_layout()
     fig.savefig(out_dir / "rcurves.png", dpi=90)
     plt.close(fig)
     made.append("rcurves.png")
 
     # where the rods break: broken elements over the crisscross lattice (theta30 (21.4, 10), every G, red and big)
-    brk = [m for m in main if m["h_e"] == 0.3 and m["size"] in ("red", "big") and m["broken_rods"] and m["_r"].frames]
+    brk = [m for m in main if m["h_e"] == 0.3 and m["size"] in ("red", "big") and m["broken_rods"] and m["breaks"]]
     if brk:
         fig, axes = plt.subplots(len(brk), 1, figsize=(12, 1.6 * len(brk) + 0.6), squeeze=False)
         for ax, m in zip(axes[:, 0], brk):
-            r = m["_r"]
-            g = r.geometry
-            th = math.radians(float(r.param("theta_D")))
+            bk = m["breaks"]
+            th = math.radians(m["theta_D"])
             p, s = 1 / math.sin(th), 1 / math.cos(th)
-            xc, yc = float(g.attrs["x_crisscross"]), float(g.attrs["y_crack_plane"])
-            xmax = (float(g.attrs["w_s"]) - xc) / p
+            xc, yc = bk["x_crisscross"], bk["y_crack_plane"]
+            xmax = (bk["w_s"] - xc) / p
             xmin = -xc / p
             n = np.arange(math.floor(2 * xmin), math.ceil(2 * xmax) + 1)
             for k in n:
                 ys = (np.arange(-4, 5) + (0.5 if k % 2 else 0.0)) * s
                 ax.plot(np.full(ys.size, k / 2), ys, ".", color="0.75", ms=3)
-            b = np.flatnonzero(r.frames[-1].beam_broken > 0)
-            mid = 0.5 * (g.node_position[g.beam_nodes[b, 0]] + g.node_position[g.beam_nodes[b, 1]])
-            ply = g.node_ply[g.beam_nodes[b, 0]]
+            mid = np.column_stack([bk["x"], bk["y"]]).reshape(-1, 2)
+            ply = np.asarray(bk["ply"], int)
             for pl, mk, col in ((0, "^", "C3"), (1, "v", "C0")):
                 sel = ply == pl
                 ax.plot((mid[sel, 0] - xc) / p, mid[sel, 1] - yc, mk, color=col, ms=6,
@@ -455,16 +603,16 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
         fig, axes = plt.subplots(1, len(Gs), figsize=(6 * len(Gs), 4.2), squeeze=False)
         for ax, G in zip(axes[0], Gs):
             for m in val:
-                if m["G"] != G or m["size"] != "red" or m["h_e"] != 0.3:
+                if m["G"] != G or m["size"] != "red" or m["h_e"] != 0.3 or not has_curve(m):
                     continue
-                r = m["_r"]
-                ax.plot(r.da, r.R, "-" if m["status"] == "completed" else ":",
+                ax.plot(m["da"], m["R"], "-" if m["status"] == "completed" else ":",
                         label=f"{m['case']} ({m['broken_rods']} rods)")
             ax.axhline(7, color="k", ls="--", lw=0.8)
             ax.set_title(f"validation cases, red 40 x 20 d, G = {G:g}")
             ax.set_xlabel(r"$\Delta a/d$")
             ax.set_ylabel(r"$R/\Gamma_i$")
-            ax.legend(fontsize=7)
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=7)
         fig.tight_layout()
         fig.savefig(out_dir / "validation_rcurves.png", dpi=90)
         plt.close(fig)
@@ -475,7 +623,7 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
                and m["case"].endswith("_e10_cv0")]
         fig, ax = plt.subplots(figsize=(6, 4.2))
         for m in pts:
-            s = float(m["_r"].param("sigma_ru_over_sigma0"))
+            s = m["sigma_ru"]
             ax.scatter(m["G"], s, s=40 + 10 * m["broken_rods"], c="C3" if m["broken_rods"] else "C0")
             ax.annotate(f"{m['R_ss']:.1f} / {m['broken_rods']}", (m["G"], s), textcoords="offset points",
                         xytext=(5, 5), fontsize=7)
@@ -491,40 +639,47 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
 
 
 def report(args) -> None:
-    rows = collect(args.runs)
-    conv = convergence(rows)
+    data = args.data
+    rows = collect(args.runs, data)
+    kept = [store(m, data) for m in rows if m["source"] == "run folder" and m["status"] == "completed"]
+    if kept:
+        print(f"identify: {len(kept)} completed runs kept in {data}", flush=True)
+    conv = convergence(rows, read_pairs(data))
     sel = select(conv)
     out = args.report_dir
     out.mkdir(parents=True, exist_ok=True)
     cols = ["size", "w_s", "h_s", "h_e", "G", "case", "status", "da_max", "R_init", "R_ss", "R_m", "R_at3", "R_end",
             "broken_rods", "da_first_rod", "xx_offset_median", "xx_offset_mean", "xx_offset_near_median", "sawtooth_period", "x_breaks",
-            "E_T", "l_over_d", "delta_f_over_d", "wall_s", "path"]
+            "E_T", "l_over_d", "delta_f_over_d", "wall_s", "path", "source", "session"]
     with open(out / "results.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
+        w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
         w.writeheader()
         for m in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in m.items() if k in cols})
     with open(out / "convergence.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(conv[0].keys()) if conv else ["G"])
+        w = csv.DictWriter(f, fieldnames=list(conv[0].keys()) if conv else ["G"], lineterminator="\n")
         w.writeheader()
         for c in conv:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in c.items()})
     made = figures(rows, conv, out)
 
     L = [f"# Identification study: results (generated by `make identify`, {datetime.datetime.now():%F %H:%M})", "",
-         "Plan, metrics and the rule: `README.md` (written first). Every number below is from the run folders "
-         "under `runs/identify/` (not committed); `results.csv` and `convergence.csv` hold them all.", "",
+         "Plan, metrics and the rule: `README.md` (written first). Every number below is from a run folder "
+         "under `runs/identify/` (not committed) when present, else from the run's committed record in `data/` "
+         "(column \"from\": *committed*, with the session of the run; README \"Changes to the plan\" 6); "
+         "`results.csv` and `convergence.csv` hold them all.", "",
          "## Runs", "",
          "| case | size | h_e | G | l/d | delta_f/d | status | Delta_a | R_init | R(3 d) | R_ss | R_m | broken | "
-         "first rod at | crisscross offset (median; nearer end, post hoc) | sawtooth period / d | break groups ((x - x_c)/(d/sin)) | wall s |",
-         "|" + "---|" * 18]
+         "first rod at | crisscross offset (median; nearer end, post hoc) | sawtooth period / d | break groups ((x - x_c)/(d/sin)) | wall s | from |",
+         "|" + "---|" * 19]
     for m in rows:
         L.append(f"| {m['case']} | {m['size']} {m['w_s']}x{m['h_s']} | {m['h_e']:g} | {m['G']:g} | {fmt(m['l_over_d'])} | "
                  f"{fmt(m['delta_f_over_d'])} | {m['status']} | {fmt(m['da_max'])} | {fmt(m['R_init'])} | "
                  f"{fmt(m['R_at3'])} | {fmt(m['R_ss'])} | {fmt(m['R_m'])} | {m['broken_rods']} | "
                  f"{fmt(m['da_first_rod'])} | {fmt(m['xx_offset_median'], '.2f')}; {fmt(m['xx_offset_near_median'], '.2f')} | "
                  f"{fmt(m['sawtooth_period'])} | "
-                 f"{m['x_breaks'] or '-'} | {fmt(m['wall_s'], '.0f')} |")
+                 f"{m['x_breaks'] or '-'} | {fmt(m['wall_s'], '.0f')} | "
+                 f"{'run folder' if m['source'] == 'run folder' else 'committed'}: {m['session']} |")
     L += ["", "l = E_T Gamma_i/sigma0^2 (E_T: /meta E_transverse_over_Er); delta_f = (G + 1) sigma0/k. "
           "R_ss: mean R over the last 20% of the advance reached. Unfinished runs (status running/interrupted) "
           "are listed but never used by the rule.", "",
@@ -537,6 +692,10 @@ def report(args) -> None:
                  f"{pct(c['l2_red_big'])} | {c['size_pair']} | {pct(c['size_l2'])} | "
                  f"{c['largest']} | {fmt(c['R_ss_largest'])} | {c['status']} | "
                  f"{pct(c['mesh_dRss'])} / {pct(c['size_dRss'])} |")
+    notes = [f"G = {c['G']:g}: {c['note']}" for c in conv if c["note"]]
+    if notes:
+        L += ["", "Distances taken from the committed `data/pairs.csv` (a run of the pair has no kept curve, so "
+              "the pair's distance is the one its own session measured): " + "; ".join(notes) + "."]
     L += ["", "## Selection (the README's rule, applied as written)", ""]
     if sel:
         L.append(f"**Selected: G = {sel['G']:g}** (converged; theta30 (21.4, 10) R_ss {sel['R_ss_largest']:.2f} at "
@@ -575,6 +734,9 @@ def main(argv=None) -> int:
                    default=pathlib.Path(os.environ.get("ENAMEL_BINARY", ROOT / "build" / "enamel-dem")))
     p.add_argument("--runs", type=pathlib.Path, default=RUNS, help="run folder root (default runs/identify)")
     p.add_argument("--report-dir", type=pathlib.Path, default=HERE, help="report folder (default studies/identify)")
+    p.add_argument("--data", type=pathlib.Path, default=DATA,
+                   help="committed per-run records, read for runs without a folder and written for every completed "
+                        "run folder (default studies/identify/data)")
     p.add_argument("--dry-run", action="store_true", help="print the runs that would be made, run nothing")
     args = p.parse_args(argv)
     if args.only is not None:
