@@ -206,15 +206,19 @@ double principalStressOfRows(const Section& s, const Vec5& f, double torque) {
   return half + std::sqrt(half * half + tau * tau);
 }
 
-double rodStress(RodStress kind, const Section& s, const Vec12& fLocal) {
-  Vec5 f;
-  for (int r = 0; r < 5; ++r) f[r] = fLocal[kStressRows[r]];
+double rodStressOfRows(RodStress kind, const Section& s, const Vec5& f, double torque) {
   switch (kind) {
     case RodStress::Axial: return axialStressOfRows(s, f);
-    case RodStress::Principal: return principalStressOfRows(s, f, fLocal[kTorsionRow]);
+    case RodStress::Principal: return principalStressOfRows(s, f, torque);
     case RodStress::AxialBending: break;
   }
   return maxTensileStressOfRows(s, f);
+}
+
+double rodStress(RodStress kind, const Section& s, const Vec12& fLocal) {
+  Vec5 f;
+  for (int r = 0; r < 5; ++r) f[r] = fLocal[kStressRows[r]];
+  return rodStressOfRows(kind, s, f, fLocal[kTorsionRow]);
 }
 
 // K phi = omega^2 M phi, ascending; negative round-off eigenvalues (rigid-body modes) clamped to 0.

@@ -95,7 +95,10 @@ inline constexpr int kTorsionRow = 9;
 // so the max over the ends is sigma_1 of the max sigma. Equals sigma when T = 0 (up to round-off).
 double principalStressOfRows(const Section& s, const Vec5& f, double torque);
 
-// The stress of `kind` from all 12 local end forces (tests; the solver reads the rows it needs).
+// The stress of `kind` from the kStressRows end forces and the torque (what the solver's alternative loop runs;
+// the default loop calls maxTensileStressOfRows directly).
+double rodStressOfRows(RodStress kind, const Section& s, const Vec5& f, double torque);
+// The same from all 12 local end forces (tests).
 double rodStress(RodStress kind, const Section& s, const Vec12& fLocal);
 
 // Free-free element eigenfrequencies omega (rad per unit time) of K phi = omega^2 M phi, ascending;

@@ -153,8 +153,8 @@ double stressOfBeamAlternative(const Model& m, const Materials& mat, const VecX&
   const int ply = m.rodPly[m.beamRod[e]];
   const beam::Vec12 ue = gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
   const beam::Vec5 fl = mat.beamStressOperator[ply].lazyProduct(ue);
-  if (mat.rodStress == beam::RodStress::Axial) return beam::axialStressOfRows(mat.section, fl);
-  return beam::principalStressOfRows(mat.section, fl, mat.beamTorsionOperator[ply].dot(ue));
+  const double torque = mat.rodStress == beam::RodStress::Principal ? mat.beamTorsionOperator[ply].dot(ue) : 0.0;
+  return beam::rodStressOfRows(mat.rodStress, mat.section, fl, torque);
 }
 }  // namespace
 
