@@ -183,6 +183,14 @@ double maxTensileStressOfRows(const Section& s, const Vec5& f) {
   return axial + std::max(bendA, bendB);
 }
 
+// L = ||S_2||_1 / A + max(||S_0||_1 c/Iy + ||S_1||_1 c/Iz, ||S_3||_1 c/Iy + ||S_4||_1 c/Iz)
+double stressChangeBound(const Section& s, const StressOperator& S) {
+  auto norm1 = [&](int r) { return S.row(r).cwiseAbs().sum(); };
+  const double endA = norm1(0) * s.c / s.Iy + norm1(1) * s.c / s.Iz;
+  const double endB = norm1(3) * s.c / s.Iy + norm1(4) * s.c / s.Iz;
+  return norm1(2) / s.A + std::max(endA, endB);
+}
+
 double maxTensileStress(const Section& s, const Vec12& fLocal) {
   Vec5 f;
   for (int r = 0; r < 5; ++r) f[r] = fLocal[kStressRows[r]];

@@ -75,6 +75,16 @@ using Vec5 = Eigen::Matrix<double, 5, 1>;
 // maxTensileStress of the end forces fLocal[kStressRows] (the code the solver runs; the Vec12 form calls it).
 double maxTensileStressOfRows(const Section& s, const Vec5& f);
 
+// The rows kStressRows of K_local T for one element orientation: u_e (12 global DOFs) -> the Vec5 above.
+using StressOperator = Eigen::Matrix<double, 5, 12, Eigen::RowMajor>;
+// How fast the stress check's stress can change with the element's displacements: for any u, u',
+//   |maxTensileStressOfRows(S u') - maxTensileStressOfRows(S u)| <= L max_i |u'_i - u_i|,
+//   L = ||S_N||_1 / A + max over the ends (||S_My||_1 c/Iy + ||S_Mz||_1 c/Iz)
+// (row norms ||.||_1 of S; the max of two ends and sqrt(a^2 + b^2) change by at most the largest change of
+// their arguments and |da| + |db|). The deletion check uses it to skip elements that cannot reach their
+// strength before the displacements have moved far enough (kernels.hpp, StressCheckSchedule).
+double stressChangeBound(const Section& s, const StressOperator& S);
+
 // Alternative rod stress definitions (case key rod_stress), for the paper's undefined "maximum rod stress
 // sigma_r,max"; the default axial_bending is maxTensileStressOfRows above. All are tension positive and
 // scale linearly with the displacements (positively homogeneous), as the static start's U_c needs.

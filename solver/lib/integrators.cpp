@@ -372,6 +372,7 @@ class LumpedIntegrator : public Integrator {
     gripOfDof_.assign(m.numDofs(), -1);
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) gripOfDof_[ops.prescribedDofs[i]] = static_cast<int>(i);
     gripResidual_ = VecX::Zero(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
+    for (double shape : ops.prescribedShape) largestShape_ = std::max(largestShape_, std::abs(shape));
     omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
     bEff_ = std::min(mat.dampB, p.damping_cap / omegaMax_);
     dt_ = p.dt_factor * 2.0 * M_PI / omegaMax_;
@@ -406,10 +407,14 @@ class LumpedIntegrator : public Integrator {
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
-    advancePositions(s);
+    const PositionMove move = advancePositions(s);
     advanceClock(mat.loading, s, dt_);
+    const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
+    moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
   }
+
+  double lastStepMoveBound() const override { return moveBound_; }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
     applyBoundaryConditions(ops, mat.loading, dt_, s);
@@ -512,12 +517,23 @@ class LumpedIntegrator : public Integrator {
   }
 
   // v_{n+1/2} replaces v_{n-1/2};  q_{n+1} = q_n + dt v_{n+1/2}
-  void advancePositions(State& s) {
+  PositionMove advancePositions(State& s) {
     s.vHalf.swap(vNext_);
-    enamel::advancePositions(s.q, s.vHalf, dt_);
+    return enamel::advancePositions(s.q, s.vHalf, dt_);
+  }
+
+  // max_i |q_{n+1,i} - q_{n,i}|: a free DOF moved by fl(q + dt v) - q, at most |dt v| plus half an ulp of the
+  // result; a grip by shape (U_{n+1} - U_n) plus the round-off of both products. So the larger of the two moves,
+  // plus 2^-52 of the largest |q| (an ulp), with a relative 1e-12 for the products.
+  double boundOfMove(const PositionMove& move, double Ubefore, double Uafter) const {
+    const double grips = largestShape_ * std::abs(Uafter - Ubefore);
+    const double largest = std::max({move.largestValue, largestShape_ * std::abs(Uafter), largestShape_ * std::abs(Ubefore)});
+    return std::max(move.largestStep, grips) * (1.0 + 1e-12) + std::ldexp(largest, -52);
   }
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
+  double largestShape_ = 0;          // max |shape| of the prescribed DOFs
+  double moveBound_ = INFINITY;      // lastStepMoveBound
   VecX mass_, invMass_, fI_, vNext_, vGripBefore_, vGrip_, gripResidual_;
   std::vector<int> gripOfDof_;                 // index into ops.prescribedDofs; -1 for a free DOF
   std::vector<double> sliceWorkM_, sliceWorkK_;  // each slice's share of the damping work's two sums

@@ -2,6 +2,7 @@
 // Time integrators. `paper` is the reference (paper eq. 12-18); fast schemes sit beside it behind the same
 // small interface and are chosen by the case key `integrator`. A scheme keeps its own data (dt, its mass or
 // factorisation, scratch); it is given the set-up data by const reference and the State by reference.
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -50,6 +51,9 @@ class Integrator {
   virtual bool usesHalfStepVelocity() const { return false; }
   /// Rotary inertia the scheme added, as a fraction of the physical one (reported in the output).
   virtual double addedRotaryInertia() const { return 0; }
+  /// A bound on how far any DOF moved in the last step, max_i |q_i(t_{n+1}) - q_i(t_n)| (round-off included);
+  /// infinite when the scheme gives none (then the deletion check computes every rod element).
+  virtual double lastStepMoveBound() const { return INFINITY; }
   /// One line on the scheme's own choices (mass scaling, damping), for the output's provenance.
   virtual std::string describe() const { return name(); }
 };

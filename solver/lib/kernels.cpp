@@ -1,5 +1,6 @@
 #include "kernels.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -128,12 +129,19 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 }
 
 // --- positions ---------------------------------------------------------------------------------------
-void advancePositions(VecX& q, const VecX& v, double dt) {
+PositionMove advancePositions(VecX& q, const VecX& v, double dt) {
   double* x = q.data();
   const double* w = v.data();
   const Eigen::Index n = q.size();
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index i = 0; i < n; ++i) x[i] += dt * w[i];
+  double largestStep = 0, largestValue = 0;  // maxima are exact: the same whatever the thread count
+#pragma omp parallel for schedule(static) reduction(max : largestStep, largestValue)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double step = dt * w[i];
+    x[i] += step;
+    largestStep = std::max(largestStep, std::abs(step));
+    largestValue = std::max(largestValue, std::abs(x[i]));
+  }
+  return PositionMove{largestStep, largestValue};
 }
 
 // --- rod elements --------------------------------------------------------------------------------------
@@ -174,6 +182,46 @@ void computeStressRatiosForBeams(const Model& m, const Materials& mat, const Vec
   }
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < m.numBeams(); ++e) ratio[e] = beamBroken[e] ? 0.0 : stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
+}
+
+// Every element afresh (drift 0, all due), or after a step that moved by `moved`: only those whose due drift
+// has come; each computed one gets its next due drift from its margin to 1 - kStressScheduleMargin.
+void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
+                               const std::vector<std::uint8_t>& beamBroken, long step, double moved,
+                               StressCheckSchedule& schedule, std::vector<double>& ratio) {
+  const int ne = m.numBeams();
+  if (mat.rodStress != beam::RodStress::AxialBending || !std::isfinite(moved)) {  // no bound: compute them all
+    computeStressRatiosForBeams(m, mat, q, beamBroken, ratio);
+    schedule.step = -1;
+    schedule.computed = ne;
+    return;
+  }
+  if (schedule.step < 0 || step != schedule.step + 1 || static_cast<int>(schedule.due.size()) != ne) {
+    schedule.drift = 0;
+    schedule.due.assign(ne, 0.0);
+    ratio.assign(ne, 0.0);
+  } else {
+    schedule.drift += moved * (1.0 + 1e-6);  // the 1e-6 covers the round-off of this running sum
+  }
+  schedule.step = step;
+  const double drift = schedule.drift;
+  double* due = schedule.due.data();
+  long computed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : computed)
+  for (int e = 0; e < ne; ++e) {
+    if (beamBroken[e]) {
+      ratio[e] = 0.0;
+      continue;
+    }
+    if (due[e] > drift) continue;  // cannot have reached 1 - margin since its last computation
+    const double strength = mat.beamStrength[e];
+    const double r = stressOfBeam(m, mat, q, e) / strength;
+    ratio[e] = r;
+    due[e] = drift + std::max(0.0, 1.0 - kStressScheduleMargin - r) * strength /
+                         mat.beamStressChangeBound[m.rodPly[m.beamRod[e]]];
+    ++computed;
+  }
+  schedule.computed = computed;
 }
 
 namespace {

@@ -41,8 +41,12 @@ void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3*
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, VecX& f);
 
+/// What a position update moved: the largest |dt v_i| added and the largest |q_i| after it.
+struct PositionMove {
+  double largestStep = 0, largestValue = 0;
+};
 /// q += dt v over all DOF (threaded): the explicit schemes' position update.
-void advancePositions(VecX& q, const VecX& v, double dt);
+PositionMove advancePositions(VecX& q, const VecX& v, double dt);
 
 /// Stress of rod element e for the brittle check (units of E_r), as case key rod_stress defines it (default
 /// beam::maxTensileStress of its local end forces).
@@ -50,6 +54,30 @@ double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, 
 /// Stress ratio sigma / sigma_ru of every intact rod element (0 for deleted ones): the deletion check.
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                  const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio);
+
+/// The deletion check's schedule (rod_stress axial_bending): which rod elements need their stress computed.
+/// An element whose ratio r = sigma/sigma_ru was computed when the displacements' drift stood at D cannot
+/// reach 1 - kStressScheduleMargin while the drift (the sum over steps of a bound on max_i |q_i change|) stays
+/// below D + (1 - kStressScheduleMargin - r) sigma_ru / L (L = Materials::beamStressChangeBound of its ply):
+/// until then it cannot break, and its stress is not computed. Scratch, not part of State: a fresh schedule
+/// computes every element once, so a restarted run deletes the same elements as the run it continues.
+inline constexpr double kStressScheduleMargin = 1e-4;
+struct StressCheckSchedule {
+  long step = -1;          // the step of the last check (-1: none); a check at any other step than the next starts afresh
+  double drift = 0;        // bound on how far any DOF moved since the schedule started
+  std::vector<double> due; // per rod element: the drift from which its stress must be computed again
+  long computed = 0;       // elements computed at the last check
+};
+
+/// The deletion check at step `step`, the displacements having moved by at most `moved` (max over DOFs; infinite
+/// when the scheme gives no bound) since the check at step - 1: ratio[e] = sigma / sigma_ru of every intact rod
+/// element that could have reached 1 - kStressScheduleMargin (and of all of them when the schedule starts
+/// afresh, `moved` is infinite, or rod_stress is not axial_bending); an element not computed keeps its last
+/// ratio, below 1 - kStressScheduleMargin as its present one is; 0 for deleted ones. The same elements pass 1
+/// as with computeStressRatiosForBeams, with the same ratios.
+void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
+                               const std::vector<std::uint8_t>& beamBroken, long step, double moved,
+                               StressCheckSchedule& schedule, std::vector<double>& ratio);
 
 /// Take rod element e out of K (its stiffness) and M (consistent minus lumped mass: its lumped mass stays).
 void removeBeamFromMatrices(const Model& m, const Materials& mat, int e, Operators& ops);

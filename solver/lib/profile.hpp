@@ -23,11 +23,13 @@ struct KernelProfile {
   long steps = 0;           // steps timed per kernel
   double dof = 0;
   double triadBytesPerSecond = 0;  // a[i] = b[i] + s c[i] over three vectors far larger than the caches
+  double stressComputedFraction = 0;  // rod elements the scheduled deletion check computed, per step, of all
   std::vector<KernelTiming> kernels;
 };
 
 /// Advance the simulation `warmup` steps, then time each kernel over `steps` steps: the whole step, the
-/// integrator's advance, the interface forces alone, the rod stress check. The simulation is advanced by the
+/// integrator's advance, the interface forces alone, the rod stress check of every element (the step runs it as
+/// scheduled: kernels.hpp StressCheckSchedule). The simulation is advanced by the
 /// timed steps (a profile is a throw-away run). The `lumped` integrator only (IntegratorError otherwise).
 KernelProfile profileKernels(Simulation& sim, long warmup, long steps);
 

@@ -181,6 +181,7 @@ Simulation::Simulation(const CaseParams& p)
     mat.beamStressOperator.emplace_back();
     for (int r = 0; r < 5; ++r) mat.beamStressOperator.back().row(r) = mat.beamLocalForceOperator.back().row(beam::kStressRows[r]);
     mat.beamTorsionOperator.push_back(mat.beamLocalForceOperator.back().row(beam::kTorsionRow));
+    mat.beamStressChangeBound.push_back(beam::stressChangeBound(section, mat.beamStressOperator.back()));
   }
   // Rod elements cut by the pre-crack carry no stiffness but keep their material's mass, lumped at their
   // nodes (as a deleted element does), so a rod end isolated by the cut is not massless. Assembled from
@@ -282,6 +283,7 @@ int threadCount() {
 }
 
 void Simulation::solveStaticElastic(double U) {
+  stressSchedule_ = StressCheckSchedule{};  // q is replaced: the next deletion check computes every element
   const SpMat Kt = assembleElasticStiffness(model, materials.beamK, &state.beamBroken, materials.law);
   std::vector<int> dofs = ops.prescribedDofs;
   std::vector<double> values;
@@ -416,7 +418,8 @@ void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool c
 int Simulation::deleteOverloadedBeams() {
   lastDeleted.clear();
   if (!materials.rodsBreakable) return 0;
-  computeStressRatiosForBeams(model, materials, state.q, state.beamBroken, beamStressRatio_);
+  checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
+                            stressSchedule_, beamStressRatio_);
   lastDeleted = findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule);
   if (lastDeleted.empty()) return 0;
   for (int e : lastDeleted) {

@@ -9,6 +9,7 @@
 
 #include "case_params.hpp"
 #include "integrators.hpp"
+#include "kernels.hpp"
 #include "state.hpp"
 
 namespace enamel {
@@ -94,9 +95,12 @@ class Simulation {
   int countFailedInterfaces() const;
   int countInelasticInterfaces() const;
   double inelasticReach() const;
+  /// The deletion check's schedule (its `computed` count: elements computed at the last step).
+  const StressCheckSchedule& stressCheckSchedule() const { return stressSchedule_; }
 
  private:
   std::vector<double> beamStressRatio_;  // scratch: sigma / sigma_ru per rod element
+  StressCheckSchedule stressSchedule_;   // scratch: which rod elements the deletion check computes
 };
 
 /// Measure E_transverse (modulus in the loading direction y) with the model itself: a static uniaxial

@@ -50,7 +50,9 @@ struct Materials {
   // element stiffness, consistent mass and lumped mass
   std::vector<beam::Mat12> beamLocalForceOperator, beamK, beamMc, beamMl;
   // per ply: the rows beam::kStressRows of beamLocalForceOperator, all that the stress check needs
-  std::vector<Eigen::Matrix<double, 5, 12, Eigen::RowMajor>> beamStressOperator;
+  std::vector<beam::StressOperator> beamStressOperator;
+  // per ply: beam::stressChangeBound of beamStressOperator (stress per unit of max |u_i| change)
+  std::vector<double> beamStressChangeBound;
   // per ply: the row beam::kTorsionRow of beamLocalForceOperator (the torque; read by rod_stress = principal only)
   std::vector<Eigen::Matrix<double, 1, 12>> beamTorsionOperator;
   double omegaMaxElement = 0;        // largest beam-element frequency (consistent mass)

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -307,6 +309,40 @@ TEST(Beam, MaxTensileStress) {
   uLocal[11] = alpha;
   EXPECT_LT(relErr(maxTensileStress(s, localEndForces(s, L, R, T.transpose() * uLocal)),
                    s.E * s.c * 2 * alpha / L), kTolStress * 1e3);
+}
+
+// stressChangeBound: for random pairs of displacements, the stress check's stress changes by at most
+// L max_i |du_i| (what lets the deletion check skip elements), and the bound is not vacuous: the displacement
+// change that follows the signs of the dominant rows reaches at least a quarter of it.
+TEST(Beam, StressChangeBoundHoldsAndIsTight) {
+  const Section s = testSection();
+  const double L = (kXb - kXa).norm();
+  const Mat3 R = localFrame(kXa, kXb);
+  const Mat12 op = localStiffness(s, L) * blockRot(R);
+  StressOperator S;
+  for (int r = 0; r < 5; ++r) S.row(r) = op.row(kStressRows[r]);
+  const double bound = stressChangeBound(s, S);
+  ASSERT_GT(bound, 0.0);
+  std::srand(3);
+  auto random12 = [] {
+    Vec12 x;
+    for (int i = 0; i < 12; ++i) x[i] = std::rand() / double(RAND_MAX) - 0.5;
+    return x;
+  };
+  double worstShare = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec12 u = 1e-3 * random12(), du = std::pow(10.0, -1 - trial % 5) * random12();
+    const double change = std::abs(maxTensileStressOfRows(s, S * (u + du)) - maxTensileStressOfRows(s, S * u));
+    const double allowed = bound * du.cwiseAbs().maxCoeff();
+    ASSERT_LE(change, allowed * (1 + 1e-12)) << "trial " << trial;
+    worstShare = std::max(worstShare, change / allowed);
+  }
+  // du = h sign(S_N + S_My(end A)) moves N and My at end A by their row norms together
+  Vec12 du;
+  for (int i = 0; i < 12; ++i) du[i] = (S(2, i) / s.A + S(0, i) * s.c / s.Iy >= 0 ? 1e-4 : -1e-4);
+  const double change = maxTensileStressOfRows(s, S * du) - maxTensileStressOfRows(s, Vec5(Vec5::Zero()));
+  EXPECT_GT(change, 0.25 * bound * 1e-4);
+  EXPECT_GT(worstShare, 0.05);
 }
 
 // K and M symmetric (local and global); M positive definite; K positive semi-definite with exactly

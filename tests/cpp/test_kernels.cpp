@@ -78,6 +78,65 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
 
 // A factorisation that fails (H = M + dt/2 C made negative definite) throws SolverError, whose exit status
 // is run_failed (11), not out_of_range (7).
+// The scheduled deletion check (StressCheckSchedule) against the check of every element, along a path of
+// displacements that loads rods past their strength: at every step the same elements are at or above
+// 1 - margin with the same ratios bit for bit (so the same ones break), while most steps compute only a few
+// elements; a step that moved further than the scheme says would be unsafe, so a jump (q replaced) must be
+// given as an infinite move, and then every element is computed.
+TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const Model& m = sim.model;
+  const Materials& mat = sim.materials;
+  const std::vector<std::uint8_t> broken(m.numBeams(), 0);
+  const VecX shape = pseudoRandomField(m.numDofs(), 1.0);
+  // the amplitude at which the most stressed element of `shape` reaches its strength
+  std::vector<double> full;
+  computeStressRatiosForBeams(m, mat, shape, broken, full);
+  const double unitRatio = *std::max_element(full.begin(), full.end());
+  ASSERT_GT(unitRatio, 0.0);
+  StressCheckSchedule schedule;
+  std::vector<double> scheduled;
+  const int steps = 400;
+  long computed = 0;
+  int overloadedSteps = 0;
+  VecX qPrev = VecX::Zero(m.numDofs());
+  for (int n = 1; n <= steps; ++n) {
+    const VecX q = (1.2 * n / steps / unitRatio) * shape;  // passes ratio 1 at step ~333
+    const double moved = (q - qPrev).cwiseAbs().maxCoeff();
+    checkStressRatiosForBeams(m, mat, q, broken, n, moved, schedule, scheduled);
+    computeStressRatiosForBeams(m, mat, q, broken, full);
+    computed += schedule.computed;
+    bool anyOverloaded = false;
+    for (int e = 0; e < m.numBeams(); ++e) {
+      if (full[e] >= 1.0 - kStressScheduleMargin) {
+        ASSERT_EQ(scheduled[e], full[e]) << "element " << e << " at step " << n;
+        anyOverloaded = anyOverloaded || full[e] >= 1.0;
+      } else {
+        ASSERT_LT(scheduled[e], 1.0 - kStressScheduleMargin) << "element " << e << " at step " << n;
+      }
+    }
+    overloadedSteps += anyOverloaded;
+    qPrev = q;
+  }
+  EXPECT_GT(overloadedSteps, 0);
+  EXPECT_LT(computed, static_cast<long>(steps) * m.numBeams() / 4) << "the schedule skips most computations";
+  // a jump given as infinite: every element computed, and equal to the full check
+  const VecX jump = (0.5 / unitRatio) * shape;
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 1, INFINITY, schedule, scheduled);
+  computeStressRatiosForBeams(m, mat, jump, broken, full);
+  EXPECT_EQ(schedule.computed, m.numBeams());
+  EXPECT_EQ(scheduled, full);
+  // after it the schedule starts afresh (all), then skips (nothing moved); a check that is not the next
+  // step's starts afresh again
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 2, 0.0, schedule, scheduled);
+  EXPECT_EQ(schedule.computed, m.numBeams());
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 3, 0.0, schedule, scheduled);
+  EXPECT_LT(schedule.computed, m.numBeams() / 4);
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 9, 0.0, schedule, scheduled);
+  EXPECT_EQ(schedule.computed, m.numBeams());
+  EXPECT_EQ(scheduled, full);
+}
+
 TEST(Kernels, FailedFactorisationIsARunFailure) {
   Simulation sim(smallCase("integrator = \"paper\"\n"));
   sim.ops.M = -sim.ops.M;
