@@ -13,6 +13,7 @@
 #include <Eigen/UmfPackSupport>
 
 #include "kernels.hpp"
+#include "node_blocks.hpp"
 #include "loading_rate.hpp"
 
 namespace enamel {
@@ -264,72 +265,7 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
   return std::sqrt(std::max(lambda, 0.0));
 }
 
-using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-
-// K in 6 x 6 node blocks (block compressed rows): one column index per block instead of one per entry, and
-// the six rows of a node summed side by side. The beam stiffness is assembled from whole 12 x 12 element
-// matrices, so every stored block is full; and since every element of a ply has the same matrix, the blocks
-// take only a handful of distinct values (10 in the bench's cases), kept once each: the product reads two
-// integers per block instead of 36 doubles.
-using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are stored
-
-struct NodeBlockMatrix {
-  int blockRows = 0;
-  std::vector<int> start;      // block row R holds blocks start[R] .. start[R + 1] - 1
-  std::vector<int> column;     // block column of each block
-  std::vector<int> valueOf;    // each block's entry in `values`
-  std::vector<double> values;  // distinct blocks, column-major: block v, entry (i, j) at values[36 v + 6 j + i]
-};
-
-NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
-  if (K.rows() % 6 != 0) throw SolverError("stiffness matrix: size not a multiple of 6");
-  NodeBlockMatrix B;
-  B.blockRows = static_cast<int>(K.rows() / 6);
-  B.start.assign(1, 0);
-  std::unordered_map<std::string, int> distinct;  // a block's 36 values, bit for bit -> its index
-  std::array<double, 36> block;
-  for (int R = 0; R < B.blockRows; ++R) {
-    const int first = static_cast<int>(K.outerIndexPtr()[6 * R]), count = K.outerIndexPtr()[6 * R + 1] - first;
-    if (count % 6 != 0) throw SolverError("stiffness matrix: a row is not made of whole 6 x 6 blocks");
-    for (int k = 0; k < count; k += 6) {
-      const int c = K.innerIndexPtr()[first + k];
-      if (c % 6 != 0) throw SolverError("stiffness matrix: a block does not start on a node");
-      for (int j = 0; j < 6; ++j)
-        for (int i = 0; i < 6; ++i) {
-          const int row = 6 * R + i, at = K.outerIndexPtr()[row] + k + j;
-          if (K.outerIndexPtr()[row + 1] - K.outerIndexPtr()[row] != count || K.innerIndexPtr()[at] != c + j)
-            throw SolverError("stiffness matrix: the rows of a node do not share one block pattern");
-          block[6 * j + i] = K.valuePtr()[at];
-        }
-      const std::string key(reinterpret_cast<const char*>(block.data()), sizeof block);
-      const auto [it, added] = distinct.emplace(key, static_cast<int>(distinct.size()));
-      if (added) B.values.insert(B.values.end(), block.begin(), block.end());
-      B.column.push_back(c / 6);
-      B.valueOf.push_back(it->second);
-    }
-    B.start.push_back(static_cast<int>(B.column.size()));
-  }
-  return B;
-}
-
-// Block row R of K times x1 and x2, (K x1)_R and (K x2)_R, in one pass over the row (the matrix is read once
-// for both products). Each row sums its entries in ascending column order, as a compressed-row product
-// would, so the result is the same bit for bit, whichever thread computes it.
-inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1, Vec6& y2) {
-  Vec6 s1 = Vec6::Zero(), s2 = Vec6::Zero();
-  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
-    const Eigen::Map<const Mat6> block(K.values.data() + 36 * static_cast<std::size_t>(K.valueOf[b]));
-    const double* a1 = x1 + 6 * K.column[b];
-    const double* a2 = x2 + 6 * K.column[b];
-    for (int j = 0; j < 6; ++j) {
-      s1 += block.col(j) * a1[j];
-      s2 += block.col(j) * a2[j];
-    }
-  }
-  y1 = s1;
-  y2 = s2;
-}
+// K in node blocks for the lumped step: node_blocks.hpp.
 
 // Fast scheme `lumped` (ours, DESIGN section 4): explicit central differences with a diagonal mass.
 //   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
@@ -397,7 +333,7 @@ class LumpedIntegrator : public Integrator {
     std::ostringstream o;
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
       << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36
-      << " distinct 6x6 stiffness blocks";
+      << " distinct 6x6 stiffness blocks" << (Kblocks_.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)");
     return o.str();
   }
 
@@ -459,6 +395,7 @@ class LumpedIntegrator : public Integrator {
     double* vNext = vNext_.data();
     double* lambda = s.lambdaMax.data();
     const NodeBlockMatrix& K = Kblocks_;
+    const bool split = !K.split.empty();
     int failed = 0;
 #pragma omp parallel reduction(+ : failed) firstprivate(law, q, v, vNext, lambda)
     {
@@ -473,7 +410,10 @@ class LumpedIntegrator : public Integrator {
           Vec6 fI;
           fI << -F, -Mo;
           Vec6 Kq, Kv;
-          multiplyBlockRow(K, node, q, v, Kq, Kv);
+          if (split)
+            multiplyBlockRowSplit(K, node, q, v, Kq, Kv);
+          else
+            multiplyBlockRow(K, node, q, v, Kq, Kv);
           for (int j = 0; j < 6; ++j) {
             const int dof = 6 * node + j;
             const double r = Kq[j] + fI[j] + b * Kv[j];

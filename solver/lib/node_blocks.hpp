@@ -1,0 +1,89 @@
+#pragma once
+// The beam stiffness K in 6 x 6 node blocks, for the lumped step's per-node K rows (integrators.cpp): each
+// distinct block stored once, and for rods that lie in xy-planes only the 18 entries that can be non-zero.
+// Plain data and inline loops; no I/O.
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <vector>
+
+namespace enamel {
+
+using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+// K in 6 x 6 node blocks (block compressed rows): one column index per block instead of one per entry, and
+// the six rows of a node summed side by side. The beam stiffness is assembled from whole 12 x 12 element
+// matrices, so every stored block is full; and since every element of a ply has the same matrix, the blocks
+// take only a handful of distinct values (10 in the bench's cases), kept once each: the product reads two
+// integers per block instead of 36 doubles.
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are stored
+
+struct NodeBlockMatrix {
+  int blockRows = 0;
+  std::vector<int> start;      // block row R holds blocks start[R] .. start[R + 1] - 1
+  std::vector<int> column;     // block column of each block
+  std::vector<int> valueOf;    // each block's entry in `values`
+  std::vector<double> values;  // distinct blocks, column-major: block v, entry (i, j) at values[36 v + 6 j + i]
+  // When every block is zero between the in-plane DOFs (ux, uy, rz) and the out-of-plane ones (uz, rx, ry), as
+  // for rods that lie in xy-planes: the 18 entries that can be non-zero, per distinct block, in the order of
+  // the product's pairs (multiplyBlockRowSplit); empty otherwise.
+  std::vector<double> split;
+};
+
+// The two DOF groups of a node that an in-plane rod's stiffness never couples, each in ascending order.
+constexpr int kInPlaneDofs[3] = {0, 1, 5}, kOutOfPlaneDofs[3] = {2, 3, 4};
+
+// The 18 entries of each distinct block that can be non-zero, in multiplyBlockRowSplit's order (the layout:
+// node_blocks.cpp); empty when some block couples the in-plane and out-of-plane DOFs.
+std::vector<double> splitBlocks(const std::vector<double>& values);
+
+// K (row-major, whole 6 x 6 blocks on node boundaries) in node blocks, with `split` filled when it applies.
+// Throws SolverError when K is not made of whole node blocks.
+NodeBlockMatrix toNodeBlocks(const SpMatRow& K);
+
+// Block row R of K times x1 and x2, (K x1)_R and (K x2)_R, in one pass over the row (the matrix is read once
+// for both products). Each row sums its entries in ascending column order, as a compressed-row product
+// would, so the result is the same bit for bit, whichever thread computes it.
+inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1, Vec6& y2) {
+  Vec6 s1 = Vec6::Zero(), s2 = Vec6::Zero();
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+    const Eigen::Map<const Mat6> block(K.values.data() + 36 * static_cast<std::size_t>(K.valueOf[b]));
+    const double* a1 = x1 + 6 * K.column[b];
+    const double* a2 = x2 + 6 * K.column[b];
+    for (int j = 0; j < 6; ++j) {
+      s1 += block.col(j) * a1[j];
+      s2 += block.col(j) * a2[j];
+    }
+  }
+  y1 = s1;
+  y2 = s2;
+}
+
+// multiplyBlockRow for blocks that do not couple the in-plane and out-of-plane DOFs (K.split not empty): the
+// 18 entries that can be non-zero instead of 36, three pairs of rows at a time, rows (4, 5) paired across the
+// groups. Every row adds the same products in the same (ascending column) order as multiplyBlockRow, and the
+// products it leaves out are exact zeros, so the result is multiplyBlockRow's (up to the sign of a zero).
+inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
+                                  Vec6& y2) {
+  typedef double Pair __attribute__((vector_size(16)));
+  Pair s01 = {0, 0}, s23 = {0, 0}, s45 = {0, 0}, t01 = {0, 0}, t23 = {0, 0}, t45 = {0, 0};
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+    const double* B = K.split.data() + 18 * static_cast<std::size_t>(K.valueOf[b]);
+    const double* a1 = x1 + 6 * K.column[b];
+    const double* a2 = x2 + 6 * K.column[b];
+    for (int k = 0; k < 3; ++k, B += 6) {
+      const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
+      const Pair b01 = {B[0], B[1]}, b23 = {B[2], B[3]}, b45 = {B[4], B[5]};
+      s01 += b01 * Pair{a1[i], a1[i]};
+      s23 += b23 * Pair{a1[o], a1[o]};
+      s45 += b45 * Pair{a1[o], a1[i]};
+      t01 += b01 * Pair{a2[i], a2[i]};
+      t23 += b23 * Pair{a2[o], a2[o]};
+      t45 += b45 * Pair{a2[o], a2[i]};
+    }
+  }
+  y1 << s01[0], s01[1], s23[0], s23[1], s45[0], s45[1];
+  y2 << t01[0], t01[1], t23[0], t23[1], t45[0], t45[1];
+}
+
+}  // namespace enamel
