@@ -60,14 +60,24 @@ double secantStiffness(const Law& law, double lambdaMax) {
   return envelopeTraction(law, lambdaMax) / lambdaMax;
 }
 
-// lambdaMax <- max(lambdaMax, lambda)
+// lambdaMax <- max(lambdaMax, lambda), except on the elastic track (below)
 // t = S(lambdaMax) (<dn>_+, dt1, dt2) + (k min(dn, 0), 0, 0)
 // (S (<dn>_+, dt1, dt2) = T/lambda (<dn>_+, dt1, dt2) with T = S lambda, without dividing by lambda.)
+// Elastic track: while k lambdaMax <= sigma0 and (k lambda)^2 <= kElasticTrack sigma0^2, S = k whatever the
+// history, so lambda (a square root) is not taken and lambdaMax is left as it is. lambdaMax then differs from
+// the largest lambda only while both are below delta0, where S = k, the damage and the dissipated energy are 0
+// and the interface is neither inelastic nor failed: the traction, and everything computed from lambdaMax, are
+// the same as with the plain maximum (proof: the largest lambda is either one that passed the track's bound,
+// and so was recorded, or one below it; tests/cpp/test_cohesive.cpp checks it along random paths).
 Vec3 computeTraction(const Law& law, const Vec3& openingLocal, double& lambdaMax) {
-  const double lambda = effectiveSeparation(openingLocal);
+  const double dnPos = std::max(openingLocal(0), 0.0);
+  const double lambdaSq = dnPos * dnPos + openingLocal(1) * openingLocal(1) + openingLocal(2) * openingLocal(2);
+  const double dn = openingLocal(0);
+  if (law.k * lambdaMax <= law.sigma0 && (law.k * law.k) * lambdaSq <= kElasticTrack * (law.sigma0 * law.sigma0))
+    return Vec3(law.k * std::max(dn, 0.0) + law.k * std::min(dn, 0.0), law.k * openingLocal(1), law.k * openingLocal(2));
+  const double lambda = std::sqrt(lambdaSq);  // = effectiveSeparation(openingLocal), the same operations
   lambdaMax = std::max(lambdaMax, lambda);
   const double S = secantStiffness(law, lambdaMax);
-  const double dn = openingLocal(0);
   return Vec3(S * std::max(dn, 0.0) + law.k * std::min(dn, 0.0), S * openingLocal(1), S * openingLocal(2));
 }
 

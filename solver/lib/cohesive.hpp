@@ -42,7 +42,9 @@ double secantStiffness(const Law& law, double lambdaMax);
 // (damage) unloading: T = envelope(lambdaMax) * lambda / lambdaMax when lambda < lambdaMax (elastic k*lambda
 // while lambdaMax <= delta0); traction vector = T/lambda * (<dn>_+, dt1, dt2); plus penalty contact
 // k * min(dn, 0) on the normal component, always, even after failure. Failed (lambdaMax >= deltaf): zero
-// except contact.
+// except contact. lambdaMax records lambda only once lambda^2 passes kElasticTrack delta0^2 (the elastic
+// track, where the law does not depend on it: cohesive.cpp); to know lambda itself use effectiveSeparation.
+inline constexpr double kElasticTrack = 1.0 - 1e-6;
 Vec3 computeTraction(const Law& law, const Vec3& openingLocal, double& lambdaMax);
 
 // Energy per unit area stored (recoverable) at this state: 0.5*S*lambda^2 + 0.5*k*<-dn>_+^2, S = secant stiffness.

@@ -301,17 +301,20 @@ void Simulation::solveStaticElastic(double U) {
 }
 
 // --- static elastic start -------------------------------------------------------------------------------
-double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const Operators& ops, const VecX& q1,
+double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const VecX& q1,
                                       const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable,
                                       bool& limitedByRod) {
   double uc = INFINITY;
   limitedByRod = false;
   if (interfacesBreakable && m.numInterfaces() > 0) {
-    // lambda_i(q1): the history an undamaged interface takes at q1 (no interface is assembled or changed)
-    std::vector<double> lambda(m.numInterfaces(), 0.0);
-    VecX f;
-    computeForcesForInterfaces(m, mat.law, ops, q1, lambda, true, f);
-    const double worst = *std::max_element(lambda.begin(), lambda.end());
+    // the largest effective separation lambda_i(q1) (no interface is assembled or changed)
+    double worst = 0;
+    for (int i = 0; i < m.numInterfaces(); ++i) {
+      const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+      const auto& g = m.ifaceGeom[i];
+      worst = std::max(worst, cohesive::effectiveSeparation(g.frame * cohesive::computeOpening(
+                                  g, q1.segment<3>(6 * A), q1.segment<3>(6 * A + 3), q1.segment<3>(6 * B), q1.segment<3>(6 * B + 3))));
+    }
     if (worst > 0) uc = mat.law.delta0() / worst;
   }
   if (mat.rodsBreakable && m.numBeams() > 0) {
@@ -353,7 +356,7 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   st.fraction = fraction;
   solveStaticElastic(1.0);
   const VecX q1 = state.q, reaction1 = state.reaction;
-  st.firstDamageDisplacement = computeFirstDamageDisplacement(model, materials, ops, q1, state.beamBroken,
+  st.firstDamageDisplacement = computeFirstDamageDisplacement(model, materials, q1, state.beamBroken,
                                                               params.interfaces_breakable, st.limitedByRod);
   if (!(std::isfinite(st.firstDamageDisplacement) && st.firstDamageDisplacement > 0))
     throw IntegratorError("static_start = " + std::to_string(fraction) +
@@ -363,7 +366,7 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   st.displacement = fraction * st.firstDamageDisplacement;
   st.time = materials.loading.timeOfDisplacement(st.displacement);
   setQuasiStaticState(ops, materials.loading, q1, reaction1, st.displacement, st.time, state);
-  // each interface's history at its current (elastic) separation
+  // each interface's history at its current (elastic) separation (recorded only near delta0: cohesive.hpp)
   VecX f;
   state.failedInterfaces = computeForcesForInterfaces(model, materials.law, ops, state.q, state.lambdaMax, true, f);
   integrator->initialise(model, materials, ops, state);

@@ -42,9 +42,8 @@ struct StaticStart {
 /// stress scales with U): the smallest of delta0 / max_i lambda_i(q1) over the interfaces (when breakable)
 /// and 1 / max_e sigma_e(q1) / sigma_ru,e over the intact rod elements (when breakable); infinite when
 /// nothing opens or is stressed. limitedByRod says which set it.
-double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const Operators& ops, const VecX& q1,
-                                      const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable,
-                                      bool& limitedByRod);
+double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const VecX& q1,
+                                      const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable, bool& limitedByRod);
 
 /// Worker threads the force loops use (set from the case key `threads` when a Simulation is built).
 int threadCount();
