@@ -66,24 +66,23 @@ inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, 
 inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
                                   Vec6& y2) {
   typedef double Pair __attribute__((vector_size(16)));
-  Pair s01 = {0, 0}, s23 = {0, 0}, s45 = {0, 0}, t01 = {0, 0}, t23 = {0, 0}, t45 = {0, 0};
-  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
-    const double* B = K.split.data() + 18 * static_cast<std::size_t>(K.valueOf[b]);
-    const double* a1 = x1 + 6 * K.column[b];
-    const double* a2 = x2 + 6 * K.column[b];
-    for (int k = 0; k < 3; ++k, B += 6) {
-      const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
-      const Pair b01 = {B[0], B[1]}, b23 = {B[2], B[3]}, b45 = {B[4], B[5]};
-      s01 += b01 * Pair{a1[i], a1[i]};
-      s23 += b23 * Pair{a1[o], a1[o]};
-      s45 += b45 * Pair{a1[o], a1[i]};
-      t01 += b01 * Pair{a2[i], a2[i]};
-      t23 += b23 * Pair{a2[o], a2[o]};
-      t45 += b45 * Pair{a2[o], a2[i]};
+  // one vector at a time: three accumulators and the block's pairs stay in the 16 SSE2 registers
+  auto product = [&](const double* x, Vec6& y) {
+    Pair s01 = {0, 0}, s23 = {0, 0}, s45 = {0, 0};
+    for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+      const double* B = K.split.data() + 18 * static_cast<std::size_t>(K.valueOf[b]);
+      const double* a = x + 6 * K.column[b];
+      for (int k = 0; k < 3; ++k, B += 6) {
+        const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
+        s01 += Pair{B[0], B[1]} * Pair{a[i], a[i]};
+        s23 += Pair{B[2], B[3]} * Pair{a[o], a[o]};
+        s45 += Pair{B[4], B[5]} * Pair{a[o], a[i]};
+      }
     }
-  }
-  y1 << s01[0], s01[1], s23[0], s23[1], s45[0], s45[1];
-  y2 << t01[0], t01[1], t23[0], t23[1], t45[0], t45[1];
+    y << s01[0], s01[1], s23[0], s23[1], s45[0], s45[1];
+  };
+  product(x1, y1);
+  product(x2, y2);
 }
 
 }  // namespace enamel
