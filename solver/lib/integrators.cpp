@@ -384,6 +384,7 @@ class LumpedIntegrator : public Integrator {
   // v_{n+1/2} goes to vNext_ (K v_{n-1/2} of the next slice still reads v_{n-1/2}) and replaces v at the end.
   // Returns the number of failed interfaces.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
+    typedef double Pair __attribute__((vector_size(16)));
     const cohesive::Law law = mat.law;
     const double a = dampA_, dt = dt_, b = bEff_, keep = 1.0 - 0.5 * a * dt, scale = 1.0 + 0.5 * a * dt;
     const double Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
@@ -414,16 +415,23 @@ class LumpedIntegrator : public Integrator {
             multiplyBlockRowSplit(K, node, q, v, Kq, Kv);
           else
             multiplyBlockRow(K, node, q, v, Kq, Kv);
+          // r and the free DOFs' v_{n+1/2}, two DOFs at a time (the same operations per DOF); then the grips
+          double r[6], vFree[6];
+          const double* vNode = v + 6 * node;
+          const double* invM = invMass_.data() + 6 * node;
+          for (int j = 0; j < 6; j += 2) {
+            const Pair rj = (Pair{Kq[j], Kq[j + 1]} + Pair{fI[j], fI[j + 1]}) + Pair{b, b} * Pair{Kv[j], Kv[j + 1]};
+            const Pair vj = (Pair{keep, keep} * Pair{vNode[j], vNode[j + 1]} - Pair{dt, dt} * (Pair{invM[j], invM[j + 1]} * rj)) /
+                            Pair{scale, scale};
+            r[j] = rj[0], r[j + 1] = rj[1], vFree[j] = vj[0], vFree[j + 1] = vj[1];
+          }
           for (int j = 0; j < 6; ++j) {
             const int dof = 6 * node + j;
-            const double r = Kq[j] + fI[j] + b * Kv[j];
             const int grip = gripOfDof_[dof];
-            double vn;
-            if (grip < 0) {
-              vn = (keep * v[dof] - dt * (invMass_[dof] * r)) / scale;
-            } else {
+            double vn = vFree[j];
+            if (grip >= 0) {
               vn = ops.prescribedShape[grip] * Vgrip;
-              gripResidual_[grip] = r;
+              gripResidual_[grip] = r[j];
             }
             vNext[dof] = vn;
             workM += vn * (mass_[dof] * vn);
