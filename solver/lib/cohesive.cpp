@@ -163,10 +163,13 @@ Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec
 }
 
 // B: (F_B, rB x F_B);  A: F_A = -F_B, (F_A, rA x F_A)
+// r x F with r = (0, ry, rz) written out: (ry Fz - rz Fy, rz Fx, -ry Fx), the general cross product less its
+// products by the zero x of the arm (equal to it, up to the sign of a zero).
 Wrench wrenchOnSide(const SliceInterface& g, const Vec3& forceOnB, bool sideB) {
-  const Vec3 arm = sideB ? Vec3(0.0, g.armBy, g.armBz) : Vec3(0.0, g.armAy, g.armAz);
-  const Vec3 force = sideB ? forceOnB : Vec3(-forceOnB);
-  return Wrench{force, arm.cross(force)};
+  const double ry = sideB ? g.armBy : g.armAy, rz = sideB ? g.armBz : g.armAz;
+  const double fx = sideB ? forceOnB.x() : -forceOnB.x(), fy = sideB ? forceOnB.y() : -forceOnB.y(),
+               fz = sideB ? forceOnB.z() : -forceOnB.z();
+  return Wrench{Vec3(fx, fy, fz), Vec3(ry * fz - rz * fy, rz * fx, -(ry * fx))};
 }
 
 // F_B as above, then the wrench on each side

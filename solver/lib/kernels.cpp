@@ -91,14 +91,14 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
 
 [[gnu::flatten]] void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
                            Vec3& moment) {
-  force.setZero();
-  moment.setZero();
+  double f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};  // plain sums (Eigen's 3-vector sums go through memory here)
   for (int k = ops.nodeIfaceStart[node]; k < ops.nodeIfaceStart[node + 1]; ++k) {
     const int i = ops.nodeIfaceList[k] >> 1;
     const cohesive::Wrench w = cohesive::wrenchOnSide(ops.ifacePacked[i], onB[i - firstIface], ops.nodeIfaceList[k] & 1);
-    force += w.force;
-    moment += w.moment;
+    for (int c = 0; c < 3; ++c) f[c] += w.force[c], mo[c] += w.moment[c];
   }
+  force = Vec3(f[0], f[1], f[2]);
+  moment = Vec3(mo[0], mo[1], mo[2]);
 }
 
 // f_iface = -(forces exerted on the nodes), slice by slice: F_B of the slice's interfaces into a buffer of the
