@@ -105,7 +105,7 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
   p.triadBytesPerSecond = measureTriad(3 * static_cast<long>(p.dof));
   p.kernels = {
       {"step", "the whole time step (integrator's advance, rod stress check, crack measure when something failed)",
-       step, bytes.interfaces + bytes.nodes + bytes.positions + bytes.stressCheck},
+       step, bytes.interfaces + bytes.nodes + bytes.positions + bytes.stressSchedule + p.stressComputedFraction * bytes.stressCheck},
       {"advance", "the integrator's step: the slice pass (interfaces, then nodes) and the position update",
        advance, bytes.interfaces + bytes.nodes + bytes.positions},
       {"  interfaces", "per interface: opening, law, force on B; per node its wrench (alone, with f written)",
