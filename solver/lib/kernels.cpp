@@ -79,11 +79,12 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
   const auto* nodes = m.ifaceNodes.data();
   for (int i = first; i < last; ++i) {
     const int A = nodes[i][0], B = nodes[i][1];
-    double lm = lambdaMax[i];
+    const double before = lambdaMax[i];
+    double lm = before;
     onB[i - first] = cohesive::computeInterfaceForceOnB(law, ops.ifacePacked[i], q.segment<3>(6 * A),
                                                         q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
                                                         q.segment<3>(6 * B + 3), lm);
-    if (update) lambdaMax[i] = lm;
+    if (update && lm != before) lambdaMax[i] = lm;  // most interfaces keep theirs: no store
     failed += cohesive::isFailed(law, lm);
   }
   return failed;
