@@ -26,16 +26,29 @@ HERE = pathlib.Path(__file__).resolve().parent
 NAMES = ("rest", "static")
 
 
+def result_file(run_dir: pathlib.Path) -> pathlib.Path:
+    """result.h5, or result.partial.h5 of a run stopped by Ctrl-C (its status then says interrupted)."""
+    done = pathlib.Path(run_dir) / "result.h5"
+    return done if done.exists() else pathlib.Path(run_dir) / "result.partial.h5"
+
+
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
-    r = results.load_result(pathlib.Path(run_dir) / "result.h5", case="theta30_s21.4_e10_cv0")
+    r = results.load_result(result_file(run_dir), case="theta30_s21.4_e10_cv0")
     m = r.meta
     keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt",
             "max_kinetic_over_strain_while_growing", "peak_memory_mb", "git_hash", "static_start")
     meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
-    meta.update(history_end(pathlib.Path(run_dir) / "result.h5"))
+    meta.update(history_end(result_file(run_dir)))
+    import h5py
+    with h5py.File(result_file(run_dir), "r") as f:  # the scene (issue 16): reach against Delta_a
+        h = f["history"]
+        da_h, reach, step_h = np.asarray(h["da_over_d"]), np.asarray(h["inelastic_reach_over_d"]), np.asarray(h["step"])
+    scene = [(float(d), float(reach[np.argmax(da_h >= d)])) for d in (0.0, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
+    # the step at which the crack first reached each Delta_a (0: its start), for the steps saved at equal advance
+    steps_at = [(float(d), int(step_h[np.argmax(da_h >= d)])) for d in (1e-9, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
     return dict(name=name, meta=meta,
                 R_init=r.R_init, R_ss=r.R_ss, R_m=r.R_m, da_max=r.da_max, broken_rods=r.broken_rods,
-                warnings=str(m.get("warnings", "")),
+                warnings=str(m.get("warnings", "")), reach_at_da=scene, steps_at_da=steps_at,
                 da=[float(f"{x:.10g}") for x in r.da], R=[float(f"{x:.10g}") for x in r.R])
 
 
@@ -49,12 +62,36 @@ def report(records: dict) -> str:
         lines.append(f"| {rec['name']} | {m.get('status')} | {m.get('steps')} | {m.get('wall_time_s', math.nan):.0f} | "
                      f"{rec['R_init']:.4f} | {rec['R_ss']:.4f} | {rec['R_m']:.4f} | {rec['da_max']:.2f} | {rec['broken_rods']} | "
                      f"{m.get('max_kinetic_over_strain_while_growing', math.nan):.3g} | {m.get('balance_end', math.nan):.2g} |")
-    steps = a["meta"].get("steps", 0) / max(b["meta"].get("steps", 1), 1)
-    wall = a["meta"].get("wall_time_s", 0) / max(b["meta"].get("wall_time_s", 1), 1e-9)
+    # over the common range, as the bench does: R at a few Delta_a, and R_ss over its last 20%
+    common = min(a["da_max"], b["da_max"])
+    at = [d for d in (0.5, 1, 2, 5, 10, 15, 20, 25, 30) if d <= common]
+    def R_at(rec, d):
+        da, R = np.array(rec["da"]), np.array(rec["R"])
+        return float(R[np.argmax(da >= d)]) if (da >= d).any() else math.nan
+    def R_ss_common(rec):
+        da, R = np.array(rec["da"]), np.array(rec["R"])
+        sel = (da >= 0.8 * common) & (da <= common)
+        return float(R[sel].mean()) if sel.any() else math.nan
+    lines += ["", f"Common range Delta_a <= {common:.2f} d; R/Gamma at the first R-curve point at or past each Delta_a:", "",
+              "| run | " + " | ".join(f"{d:g} d" for d in at) + " | R_ss of the common range |",
+              "|---|" + "---|" * (len(at) + 1)]
+    for rec in (a, b):
+        lines.append(f"| {rec['name']} | " + " | ".join(f"{R_at(rec, d):.4f}" for d in at) + f" | {R_ss_common(rec):.4f} |")
+    # steps to the same crack advance: the last Delta_a both reached
+    sa, sb = dict(a["steps_at_da"]), dict(b["steps_at_da"])
+    last = max(d for d in sa if d in sb)
+    steps = sa[last] / sb[last]
     lines += ["", f"R-curve relative L2 (static start against from rest, common Delta_a range): **{l2:.3g}** "
               f"(bound 0.02: {'within' if l2 <= 0.02 else 'OUTSIDE'}); R_init {b['R_init'] / a['R_init'] - 1:+.2e}, "
-              f"R_ss {b['R_ss'] / a['R_ss'] - 1:+.2e}, broken rods {b['broken_rods'] - a['broken_rods']:+d}; "
-              f"steps from rest / static {steps:.3f}, stepping wall time {wall:.3f}."]
+              f"R_ss of the common range {R_ss_common(b) / R_ss_common(a) - 1:+.2e}, broken rods {b['broken_rods'] - a['broken_rods']:+d}; "
+              f"steps to Delta_a = {last:g} d from rest / with the static start: {sa[last]} / {sb[last]} = {steps:.3f}."]
+    lines += ["", "How far the inelastic zone reaches from the crack plane (`/history/inelastic_reach_over_d`, first history "
+              "row at or past each Delta_a; half-height 50 d):", ""]
+    cols = max((a, b), key=lambda rec: len(rec["reach_at_da"]))["reach_at_da"]
+    lines += ["| Delta_a/d | " + " | ".join(f"{d:g}" for d, _ in cols) + " |", "|---|" + "---|" * len(cols)]
+    for rec in (a, b):
+        cells = [f"{r:.1f}" for _, r in rec["reach_at_da"]] + ["-"] * (len(cols) - len(rec["reach_at_da"]))
+        lines.append(f"| reach/d, {rec['name']} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
