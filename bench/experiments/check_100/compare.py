@@ -95,7 +95,30 @@ def report(records: dict) -> str:
     return "\n".join(lines)
 
 
-def plot(records: dict, out: pathlib.Path) -> None:
+def extra_report(rest: dict, extras: dict) -> str:
+    """Further variants (e.g. a faster loading rate) against the run from rest: R-curve L2, R_init, the steps to
+    the last Delta_a both reached, broken rods, the largest KE/SE."""
+    if not extras:
+        return ""
+    lines = ["", "", "Further variants against the run from rest:", "",
+             "| variant | Delta_a max/d | R-curve L2 | R_init | R/Gamma at 5, 10, 20 d | broken rods | steps (rest / variant) | KE/SE max |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, rec in extras.items():
+        l2 = metrics.rcurve_rel_l2(np.array(rest["da"]), np.array(rest["R"]), np.array(rec["da"]), np.array(rec["R"]))
+        sa, sv = dict(rest["steps_at_da"]), dict(rec["steps_at_da"])
+        last = max(d for d in sv if d in sa)
+        def R_at(r, d):
+            da, R = np.array(r["da"]), np.array(r["R"])
+            return f"{R[np.argmax(da >= d)]:.2f}" if (da >= d).any() else "-"
+        lines.append(f"| {name} | {rec['da_max']:.2f} | {l2:.3g} ({'within' if l2 <= 0.02 else 'outside'} 2%) | "
+                     f"{rec['R_init'] / rest['R_init'] - 1:+.2%} | " + ", ".join(R_at(rec, d) for d in (5, 10, 20)) +
+                     f" (rest {', '.join(R_at(rest, d) for d in (5, 10, 20))}) | {rec['broken_rods']} ({rest['broken_rods']}) | "
+                     f"{sa[last]} / {sv[last]} = {sa[last] / sv[last]:.2f} to {last:g} d | "
+                     f"{rec['meta'].get('max_kinetic_over_strain_while_growing', math.nan):.3g} |")
+    return "\n".join(lines)
+
+
+def plot(records: dict, out: pathlib.Path, extras: dict | None = None) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -103,6 +126,8 @@ def plot(records: dict, out: pathlib.Path) -> None:
     for name, style in (("rest", "-"), ("static", "--")):
         rec = records[name]
         ax.plot(rec["da"], rec["R"], style, label={"rest": "lumped from rest", "static": "static start 0.95 (bench-paper's)"}[name])
+    for name, rec in (extras or {}).items():
+        ax.plot(rec["da"], rec["R"], ":", lw=1, label=f"{name} (static start)")
     ax.set_xlabel(r"$\Delta a / d$")
     ax.set_ylabel(r"$R / \Gamma_i$")
     ax.set_title(r"100 x 100 d, $\theta_D$ = 30 (21.4, 10)", fontsize=9)
@@ -115,19 +140,26 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rest", type=pathlib.Path, help="run folder of the run from rest (writes record_rest.json)")
     ap.add_argument("--static", type=pathlib.Path, help="run folder of the static-start run (writes record_static.json)")
+    ap.add_argument("--extra", action="append", default=[], metavar="NAME=RUN_DIR",
+                    help="a further variant's run (writes record_NAME.json; the report compares it with the run from rest)")
     ap.add_argument("--out", type=pathlib.Path, default=HERE, help="folder of the records and the report")
     args = ap.parse_args(argv)
     for name in NAMES:
         run = getattr(args, name)
         if run is not None:
             (args.out / f"record_{name}.json").write_text(json.dumps(record_of(run, name), indent=1) + "\n")
+    for item in args.extra:
+        name, _, run = item.partition("=")
+        (args.out / f"record_{name}.json").write_text(json.dumps(record_of(pathlib.Path(run), name), indent=1) + "\n")
     try:
         records = {n: json.loads((args.out / f"record_{n}.json").read_text()) for n in NAMES}
     except FileNotFoundError as e:
         print(f"compare: missing record {e.filename}: run with --rest and --static first", file=sys.stderr)
         return 3
-    text = report(records)
-    plot(records, args.out / "rcurves.png")
+    extras = {p.stem[len("record_"):]: json.loads(p.read_text()) for p in sorted(args.out.glob("record_*.json"))
+              if p.stem[len("record_"):] not in NAMES}
+    text = report(records) + extra_report(records["rest"], extras)
+    plot(records, args.out / "rcurves.png", extras)
     print(text)
     return 0
 
