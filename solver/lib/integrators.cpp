@@ -1,12 +1,10 @@
 #include "integrators.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/CholmodSupport>
@@ -384,7 +382,7 @@ class LumpedIntegrator : public Integrator {
   // v_{n+1/2} goes to vNext_ (K v_{n-1/2} of the next slice still reads v_{n-1/2}) and replaces v at the end.
   // Returns the number of failed interfaces.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
-    typedef double Pair __attribute__((vector_size(16)));
+    using Pair = DoublePair;
     const cohesive::Law law = mat.law;
     const double a = dampA_, dt = dt_, b = bEff_, keep = 1.0 - 0.5 * a * dt, scale = 1.0 + 0.5 * a * dt;
     const double Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);

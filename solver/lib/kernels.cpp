@@ -90,6 +90,13 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
   return failed;
 }
 
+cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i) {
+  const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+  const auto& g = m.ifaceGeom[i];
+  return g.frame * cohesive::computeOpening(g, q.segment<3>(6 * A), q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
+                                            q.segment<3>(6 * B + 3));
+}
+
 [[gnu::flatten]] void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
                            Vec3& moment) {
   double f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};  // plain sums (Eigen's 3-vector sums go through memory here)

@@ -28,6 +28,10 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
 int computeForcesForInterfacesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k, const VecX& q,
                                       double* lambdaMax, bool update, cohesive::Vec3* onB);
 
+/// The local opening (n, t1, t2) of interface i at displacements q, in the general form (measurements and
+/// set-up: energies, the static start's U_c; the step reads the compact form).
+cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i);
+
 /// The wrench (force, moment) that a node's interfaces exert on it, summed over its interface ends in the
 /// fixed CSR order (so it does not depend on the thread count); onB as computeForcesForInterfacesOfSlice left
 /// it for the node's slice, whose first interface is `firstIface`.

@@ -16,6 +16,8 @@ using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 // take only a handful of distinct values (10 in the bench's cases), kept once each: the product reads two
 // integers per block instead of 36 doubles.
 using Vec6 = Eigen::Matrix<double, 6, 1>;
+// Two doubles side by side (GCC/Clang vector extension: one SSE2 register): the lumped step's paired loops.
+typedef double DoublePair __attribute__((vector_size(16)));
 using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are stored
 
 struct NodeBlockMatrix {
@@ -65,7 +67,7 @@ inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, 
 // products it leaves out are exact zeros, so the result is multiplyBlockRow's (up to the sign of a zero).
 inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
                                   Vec6& y2) {
-  typedef double Pair __attribute__((vector_size(16)));
+  using Pair = DoublePair;
   // one vector at a time: three accumulators and the block's pairs stay in the 16 SSE2 registers
   auto product = [&](const double* x, Vec6& y) {
     Pair s01 = {0, 0}, s23 = {0, 0}, s45 = {0, 0};

@@ -309,12 +309,8 @@ double computeFirstDamageDisplacement(const Model& m, const Materials& mat, cons
   if (interfacesBreakable && m.numInterfaces() > 0) {
     // the largest effective separation lambda_i(q1) (no interface is assembled or changed)
     double worst = 0;
-    for (int i = 0; i < m.numInterfaces(); ++i) {
-      const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-      const auto& g = m.ifaceGeom[i];
-      worst = std::max(worst, cohesive::effectiveSeparation(g.frame * cohesive::computeOpening(
-                                  g, q1.segment<3>(6 * A), q1.segment<3>(6 * A + 3), q1.segment<3>(6 * B), q1.segment<3>(6 * B + 3))));
-    }
+    for (int i = 0; i < m.numInterfaces(); ++i)
+      worst = std::max(worst, cohesive::effectiveSeparation(computeLocalOpening(m, q1, i)));
     if (worst > 0) uc = mat.law.delta0() / worst;
   }
   if (mat.rodsBreakable && m.numBeams() > 0) {
@@ -450,11 +446,8 @@ double Simulation::strainEnergyOfInterfaces() const {
   std::vector<double> energy(m.numInterfaces());
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < m.numInterfaces(); ++i) {
-    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-    const auto& g = m.ifaceGeom[i];
-    const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
-                                                         state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
-    energy[i] = g.area * cohesive::storedEnergyDensity(materials.law, open, state.lambdaMax[i]);
+    energy[i] = m.ifaceGeom[i].area *
+                cohesive::storedEnergyDensity(materials.law, computeLocalOpening(m, state.q, i), state.lambdaMax[i]);
   }
   return std::accumulate(energy.begin(), energy.end(), 0.0);
 }
@@ -515,11 +508,8 @@ double Simulation::computeJ() const {
     }
     for (int i = 0; i < m.numInterfaces(); ++i) {
       if (m.ifaceSlice[i] != slice) continue;
-      const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
-      const auto& g = m.ifaceGeom[i];
-      const Vec3 open = g.frame * cohesive::computeOpening(g, state.q.segment<3>(6 * A), state.q.segment<3>(6 * A + 3),
-                                                           state.q.segment<3>(6 * B), state.q.segment<3>(6 * B + 3));
-      ei += g.area * cohesive::storedEnergyDensity(materials.law, open, state.lambdaMax[i]);
+      ei += m.ifaceGeom[i].area *
+            cohesive::storedEnergyDensity(materials.law, computeLocalOpening(m, state.q, i), state.lambdaMax[i]);
     }
     return eb / m.h_e + ei / (0.5 * m.h_e);
   };

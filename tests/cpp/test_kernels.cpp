@@ -217,12 +217,8 @@ TEST(Kernels, StaticStartIsEquilibriumAtAFractionOfFirstDamage) {
     EXPECT_EQ(s.step, 0);
     // the limit that sets U_c is reached at exactly `fraction` of it
     double worstLambda = 0;  // the largest effective separation (lambdaMax records none below delta0)
-    for (int i = 0; i < sim.model.numInterfaces(); ++i) {
-      const int A = sim.model.ifaceNodes[i][0], B = sim.model.ifaceNodes[i][1];
-      const auto& g = sim.model.ifaceGeom[i];
-      worstLambda = std::max(worstLambda, cohesive::effectiveSeparation(g.frame * cohesive::computeOpening(
-          g, s.q.segment<3>(6 * A), s.q.segment<3>(6 * A + 3), s.q.segment<3>(6 * B), s.q.segment<3>(6 * B + 3))));
-    }
+    for (int i = 0; i < sim.model.numInterfaces(); ++i)
+      worstLambda = std::max(worstLambda, cohesive::effectiveSeparation(computeLocalOpening(sim.model, s.q, i)));
     std::vector<double> ratio;
     computeStressRatiosForBeams(sim.model, sim.materials, s.q, s.beamBroken, ratio);
     const double worstRod = *std::max_element(ratio.begin(), ratio.end());
