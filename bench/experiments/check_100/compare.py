@@ -52,6 +52,12 @@ def record_of(run_dir: pathlib.Path, name: str) -> dict:
                 da=[float(f"{x:.10g}") for x in r.da], R=[float(f"{x:.10g}") for x in r.R])
 
 
+def R_at(rec: dict, d: float) -> float:
+    """R/Gamma at the first R-curve point at or past Delta_a = d (nan when the crack did not get there)."""
+    da, R = np.array(rec["da"]), np.array(rec["R"])
+    return float(R[np.argmax(da >= d)]) if (da >= d).any() else math.nan
+
+
 def report(records: dict) -> str:
     a, b = records["rest"], records["static"]
     l2 = metrics.rcurve_rel_l2(np.array(a["da"]), np.array(a["R"]), np.array(b["da"]), np.array(b["R"]))
@@ -65,9 +71,6 @@ def report(records: dict) -> str:
     # over the common range, as the bench does: R at a few Delta_a, and R_ss over its last 20%
     common = min(a["da_max"], b["da_max"])
     at = [d for d in (0.5, 1, 2, 5, 10, 15, 20, 25, 30) if d <= common]
-    def R_at(rec, d):
-        da, R = np.array(rec["da"]), np.array(rec["R"])
-        return float(R[np.argmax(da >= d)]) if (da >= d).any() else math.nan
     def R_ss_common(rec):
         da, R = np.array(rec["da"]), np.array(rec["R"])
         sel = (da >= 0.8 * common) & (da <= common)
@@ -107,12 +110,9 @@ def extra_report(rest: dict, extras: dict) -> str:
         l2 = metrics.rcurve_rel_l2(np.array(rest["da"]), np.array(rest["R"]), np.array(rec["da"]), np.array(rec["R"]))
         sa, sv = dict(rest["steps_at_da"]), dict(rec["steps_at_da"])
         last = max(d for d in sv if d in sa)
-        def R_at(r, d):
-            da, R = np.array(r["da"]), np.array(r["R"])
-            return f"{R[np.argmax(da >= d)]:.2f}" if (da >= d).any() else "-"
         lines.append(f"| {name} | {rec['da_max']:.2f} | {l2:.3g} ({'within' if l2 <= 0.02 else 'outside'} 2%) | "
-                     f"{rec['R_init'] / rest['R_init'] - 1:+.2%} | " + ", ".join(R_at(rec, d) for d in (5, 10, 20)) +
-                     f" (rest {', '.join(R_at(rest, d) for d in (5, 10, 20))}) | {rec['broken_rods']} ({rest['broken_rods']}) | "
+                     f"{rec['R_init'] / rest['R_init'] - 1:+.2%} | " + ", ".join(f"{R_at(rec, d):.2f}" for d in (5, 10, 20)) +
+                     f" (rest {', '.join(f'{R_at(rest, d):.2f}' for d in (5, 10, 20))}) | {rec['broken_rods']} ({rest['broken_rods']}) | "
                      f"{sa[last]} / {sv[last]} = {sa[last] / sv[last]:.2f} to {last:g} d | "
                      f"{rec['meta'].get('max_kinetic_over_strain_while_growing', math.nan):.3g} |")
     return "\n".join(lines)
