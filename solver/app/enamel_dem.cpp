@@ -79,6 +79,12 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   std::printf("beam elements      %d (+%d cut by the pre-crack), length %.4f d\n", m.numBeams(), m.precrackBeams,
               m.beamLength);
   std::printf("interfaces         %d (+%d cut by the pre-crack)\n", m.numInterfaces(), m.precrackInterfaces);
+  if (m.hasFarField()) {
+    int longBeams = 0;
+    for (int e = 0; e < m.numBeams(); ++e) longBeams += m.beamSpan[e] > 1;
+    std::printf("reduced far field  a node every %d slices beyond |y - h_s/2| = %g d: %d rod elements longer than "
+                "one slice\n", m.farFieldSlices, m.fullHalfHeight, longBeams);
+  }
   for (int t = 0; t < 4; ++t) std::printf("  %-30s %d\n", interfaceTagName(t), byTag[t]);
   std::printf("element frequency  omega_max %.4g c_r/d: %s governs (bending %.4g, axial %.4g)\n",
               mat.omegaMaxElement, wBend > wAxial ? "bending" : "axial", wBend, wAxial);

@@ -477,6 +477,11 @@ void checkCrossKeys(const CaseParams& p, const std::string& src) {
     if (slices < 2)
         fail("w_s_over_d = " + formatNumber(p.w_s_over_d) + " with h_e_over_d = " + formatNumber(p.h_e_over_d) +
              " gives " + formatNumber(slices) + " slice; at least 2 are needed");
+    // A reduced far field needs its full band: at least 1 d on each side of the crack plane.
+    if (p.far_field_slices > 1 && !(p.full_half_height_over_d >= 1))
+        fail("key 'full_half_height_over_d' = " + formatNumber(p.full_half_height_over_d) +
+             " is out of range; allowed [1, 1000] d when far_field_slices = " +
+             formatNumber(static_cast<double>(p.far_field_slices)) + " > 1 (the full band around the crack plane)");
 }
 
 // The effective case as flat TOML, every key, in table order.

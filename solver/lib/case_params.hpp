@@ -113,6 +113,13 @@ enum class Need { required, optional };
       "static elastic start: start from the static elastic solution at this fraction of the applied "               \
       "displacement U_c at which the first interface reaches delta0 (or the first rod element its strength, "       \
       "if earlier), moving at the quasi-static velocity of the loading; 0 = start from rest")                       \
+    X(far_field_slices, Integer, numerics, optional, 1, "[]", 1, 64, "", "slices",                                  \
+      "reduced far field: outside the full band |y - h_s/2| <= full_half_height_over_d a rod keeps a node in "      \
+      "every this many slices (longer rod elements) and the interfaces there are lumped onto those nodes; the run " \
+      "stops when the inelastic zone comes within 2 d of the band's edge; 1 = off (README, Reduced far field)")    \
+    X(full_half_height_over_d, Real, numerics, optional, 0, "[]", 0, 1000, "", "d",                                 \
+      "full band half-height: of the reduced far field (far_field_slices > 1): every slice is kept within this "    \
+      "distance of the crack plane; at least 1 d")                                                                  \
     X(zeta, Real, numerics, optional, 0.2, "[]", 0, 1, "", "-",                                                     \
       "Rayleigh damping: damping ratio at w_min = pi c_d / h_s (C = a M + b K)")                                    \
     X(dt_factor, Real, numerics, optional, 0.1, "(]", 0, 1, "", "smallest element period",                          \

@@ -142,9 +142,11 @@ void numberNodesBySlice(Model& m) {
   std::stable_sort(beams.begin(), beams.end(), [&](int a, int b) { return m.beamNodes[a][0] < m.beamNodes[b][0]; });
   const auto oldNodes = m.beamNodes;
   const auto oldRod = m.beamRod;
+  const auto oldSpan = m.beamSpan;
   for (int e = 0; e < m.numBeams(); ++e) {
     m.beamNodes[e] = oldNodes[beams[e]];
     m.beamRod[e] = oldRod[beams[e]];
+    m.beamSpan[e] = oldSpan[beams[e]];
   }
   for (auto& ab : m.ifaceNodes) ab = {newId[ab[0]], newId[ab[1]]};
   for (int& n : m.topNodes) n = newId[n];
@@ -209,6 +211,7 @@ Model buildCrossply(const GeometryParams& p) {
           } else {
             m.beamNodes.push_back({node - 1, node});
             m.beamRod.push_back(rod);
+            m.beamSpan.push_back(1);
           }
         }
       }

@@ -10,6 +10,7 @@
 // The model is plain arrays, one set per kind of thing (nodes, beams, interfaces), ready for explicit
 // loops and for deleting elements (the solver keeps alive flags; the geometry never changes afterwards).
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -68,14 +69,19 @@ struct Model {
   // --- beam elements (rod segments between consecutive slices), in the order of their first node ---
   std::vector<std::array<int, 2>> beamNodes;
   std::vector<int> beamRod;
-  double beamLength = 0;             // h_e / cos(theta), the same for all beams
+  std::vector<std::int8_t> beamSpan; // slices an element spans: 1, or up to farFieldSlices in a reduced far field
+  double beamLength = 0;             // h_e / cos(theta): the length of a one-slice element
+  /// Element class (one set of element matrices each): 2 (span - 1) + ply.
+  int beamClass(int e) const { return 2 * (beamSpan[e] - 1) + rodPly[beamRod[e]]; }
+  int numBeamClasses() const { return 2 * farFieldSlices; }
+  double beamLengthOfClass(int c) const { return (c / 2 + 1) * beamLength; }
 
   // --- interface elements ---
   std::vector<std::array<int, 2>> ifaceNodes;            // A, B (B possibly through the periodic wrap)
   std::vector<cohesive::InterfaceGeometry> ifaceGeom;    // frame, arms, area
   std::vector<std::int8_t> ifaceTag;
   std::vector<int> ifaceSlice;
-  std::vector<double> ifaceEdgeLength;                   // l_i
+  std::vector<double> ifaceEdgeLength;                   // l_i (lumped: area / the length along x it stands for)
   std::vector<std::int8_t> ifaceZShift;                  // image of B used: z_B + shift * B
 
   // --- boundary node sets (loaded in u_y): topmost / bottommost node of each ply in each slice ---
@@ -86,6 +92,11 @@ struct Model {
   std::vector<std::array<int, 2>> precrackIfaceRods;  // rods of each removed interface
   std::vector<int> precrackIfaceSlice;
   std::vector<int> precrackBeamRod, precrackBeamSlice;  // rod and first slice of each removed beam
+
+  // --- reduced far field (far_field.hpp): 1 and infinity in the full model ---
+  int farFieldSlices = 1;            // outside the full band, a rod keeps a node in every this many slices
+  double fullHalfHeight = INFINITY;  // the full band: |y - yCrack| <= fullHalfHeight
+  bool hasFarField() const { return farFieldSlices > 1 && fullHalfHeight < 0.5 * h_s; }
 
   int numNodes() const { return static_cast<int>(X.size()); }
   int numBeams() const { return static_cast<int>(beamNodes.size()); }

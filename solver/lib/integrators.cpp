@@ -291,15 +291,17 @@ class LumpedIntegrator : public Integrator {
     const double L = m.beamLength;
     rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
     Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
-    const double mt = 0.5 * mat.section.rho * mat.section.A * L;
-    const double jr = rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * L;
+    // per element end, of an element spanning `span` slices (1 but in a reduced far field)
+    auto mt = [&](int span) { return 0.5 * mat.section.rho * mat.section.A * (span * L); };
+    auto jr = [&](int span) { return rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * (span * L); };
     mass_ = VecX::Zero(m.numDofs());
-    auto addElementMass = [&](int a, int b) {
+    auto addElementMass = [&](int a, int b, int span) {
+      const double t = mt(span), r = jr(span);
       for (int node : {a, b})
-        for (int k = 0; k < 3; ++k) { mass_[6 * node + k] += mt; mass_[6 * node + 3 + k] += jr; }
+        for (int k = 0; k < 3; ++k) { mass_[6 * node + k] += t; mass_[6 * node + 3 + k] += r; }
     };
-    for (int e = 0; e < m.numBeams(); ++e) addElementMass(m.beamNodes[e][0], m.beamNodes[e][1]);
-    for (const auto& ab : ops.cutBeamNodes) addElementMass(ab[0], ab[1]);  // cut by the pre-crack: mass stays
+    for (int e = 0; e < m.numBeams(); ++e) addElementMass(m.beamNodes[e][0], m.beamNodes[e][1], m.beamSpan[e]);
+    for (const auto& ab : ops.cutBeamNodes) addElementMass(ab[0], ab[1], 1);  // cut by the pre-crack: mass stays
     for (int i = 0; i < mass_.size(); ++i)
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();

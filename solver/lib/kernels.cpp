@@ -158,7 +158,7 @@ namespace {
 // beam::kStressRows enter. Always inlined: the deletion check below runs it for every rod element at every
 // step (a call costs ~20% of that loop).
 [[gnu::always_inline]] inline double stressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
-  const beam::Vec5 fl = mat.beamStressOperator[m.rodPly[m.beamRod[e]]].lazyProduct(
+  const beam::Vec5 fl = mat.beamStressOperator[m.beamClass(e)].lazyProduct(
       gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]));
   return beam::maxTensileStressOfRows(mat.section, fl);
 }
@@ -166,10 +166,10 @@ namespace {
 // The alternative definitions of case key rod_stress (beam.hpp RodStress); axial_bending is stressOfBeam above.
 // principal reads one more row of K_local T, the torque.
 double stressOfBeamAlternative(const Model& m, const Materials& mat, const VecX& q, int e) {
-  const int ply = m.rodPly[m.beamRod[e]];
+  const int c = m.beamClass(e);
   const beam::Vec12 ue = gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
-  const beam::Vec5 fl = mat.beamStressOperator[ply].lazyProduct(ue);
-  const double torque = mat.rodStress == beam::RodStress::Principal ? mat.beamTorsionOperator[ply].dot(ue) : 0.0;
+  const beam::Vec5 fl = mat.beamStressOperator[c].lazyProduct(ue);
+  const double torque = mat.rodStress == beam::RodStress::Principal ? mat.beamTorsionOperator[c].dot(ue) : 0.0;
   return beam::rodStressOfRows(mat.rodStress, mat.section, fl, torque);
 }
 }  // namespace
@@ -226,7 +226,7 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
     const double r = stressOfBeam(m, mat, q, e) / strength;
     ratio[e] = r;
     due[e] = drift + std::max(0.0, 1.0 - kStressScheduleMargin - r) * strength /
-                         mat.beamStressChangeBound[m.rodPly[m.beamRod[e]]];
+                         mat.beamStressChangeBound[m.beamClass(e)];
     ++computed;
   }
   schedule.computed = computed;
@@ -243,9 +243,9 @@ void addElementInPlace(SpMat& A, const beam::Mat12& Ke, int a, int b, double sig
 // K -= K_e;  M -= (M_e,consistent - M_e,lumped)
 void removeBeamFromMatrices(const Model& m, const Materials& mat, int e, Operators& ops) {
   const int a = m.beamNodes[e][0], b = m.beamNodes[e][1];
-  const int ply = m.rodPly[m.beamRod[e]];
-  addElementInPlace(ops.K, mat.beamK[ply], a, b, -1.0);
-  addElementInPlace(ops.M, mat.beamMc[ply] - mat.beamMl[ply], a, b, -1.0);
+  const int c = m.beamClass(e);
+  addElementInPlace(ops.K, mat.beamK[c], a, b, -1.0);
+  addElementInPlace(ops.M, mat.beamMc[c] - mat.beamMl[c], a, b, -1.0);
 }
 
 }  // namespace enamel

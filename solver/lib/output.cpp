@@ -298,6 +298,9 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       for (const auto& b : m.beamNodes) bn.insert(bn.end(), {b[0], b[1]});
       for (const auto& b : m.ifaceNodes) in.insert(in.end(), {b[0], b[1]});
       dataset(g.id, "beam_nodes", bn, 2, "-");
+      std::vector<int> span(m.beamSpan.begin(), m.beamSpan.end());
+      dataset(g.id, "beam_span", span, 1, "slices",
+              "slices a rod element spans: 1, more in a reduced far field (length span h_e / cos theta)");
       dataset(g.id, "beam_strength_over_sigma0", [&] {
         std::vector<double> s(sim.materials.beamStrength);
         for (double& v : s) v /= p.sigma0();
@@ -327,6 +330,8 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "y_crack_plane", m.yCrack);
       attr(g.id, "x_crisscross", m.xCrisscross);
       attr(g.id, "num_slices", static_cast<long>(m.numSlices));
+      attr(g.id, "far_field_slices", static_cast<long>(m.farFieldSlices));
+      attr(g.id, "full_band_half_height", m.hasFarField() ? m.fullHalfHeight : 0.5 * m.h_s);
     }
     // --- /frames ---
     {

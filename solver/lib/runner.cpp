@@ -174,6 +174,14 @@ class RunLoop {
       rec_.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
                                   kineticRatio, s.step, kKineticWarn));
     }
+    // A reduced far field holds only while the inelastic zone stays inside the full band.
+    const Model& m = sim_.model;
+    if (m.hasFarField() && r.inelasticReach > m.fullHalfHeight - kEdgeWarnDistance)
+      return fail(fmt("inelastic zone reached %.3g d from the crack plane at step %.0f (Delta_a %.3g d), ",
+                      r.inelasticReach, s.step, s.crackAdvance) +
+                  fmt("within %.2g d of the edge of the full band (full_half_height_over_d = %g): the reduced far "
+                      "field (far_field_slices = %.0f) is no longer elastic there; rerun with a wider band",
+                      kEdgeWarnDistance, m.fullHalfHeight, double(m.farFieldSlices)));
     // The inelastic zone near the loaded edges: the R-curve may depend on the specimen's height.
     const double halfHeight = 0.5 * sim_.model.h_s;
     if (!rec_.warnedEdge && r.inelasticReach > halfHeight - kEdgeWarnDistance) {

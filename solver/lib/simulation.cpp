@@ -8,6 +8,7 @@
 
 #include <Eigen/CholmodSupport>
 
+#include "far_field.hpp"
 #include "kernels.hpp"
 #include "strength.hpp"
 
@@ -49,11 +50,11 @@ void addElementTriplets(std::vector<Eigen::Triplet<double>>& trip, const beam::M
       trip.emplace_back(dof[i / 6] + i % 6, dof[j / 6] + j % 6, Ke(i, j));
 }
 
-SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perPly, int nDofs,
+SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perClass, int nDofs,
                     std::vector<Eigen::Triplet<double>> trip = {}) {
   trip.reserve(trip.size() + static_cast<std::size_t>(m.numBeams()) * 144);
   for (int e = 0; e < m.numBeams(); ++e)
-    addElementTriplets(trip, perPly[m.rodPly[m.beamRod[e]]], m.beamNodes[e][0], m.beamNodes[e][1]);
+    addElementTriplets(trip, perClass[m.beamClass(e)], m.beamNodes[e][0], m.beamNodes[e][1]);
   SpMat A(nDofs, nDofs);
   A.setFromTriplets(trip.begin(), trip.end());
   return A;
@@ -89,12 +90,12 @@ VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const s
   return u;
 }
 
-SpMat assembleElasticStiffness(const Model& m, const std::vector<beam::Mat12>& beamKPerPly,
+SpMat assembleElasticStiffness(const Model& m, const std::vector<beam::Mat12>& beamKPerClass,
                                const std::vector<std::uint8_t>* beamBroken, const cohesive::Law& law) {
   std::vector<Eigen::Triplet<double>> trip;
   for (int e = 0; e < m.numBeams(); ++e)
     if (!beamBroken || !(*beamBroken)[e])
-      addElementTriplets(trip, beamKPerPly[m.rodPly[m.beamRod[e]]], m.beamNodes[e][0], m.beamNodes[e][1]);
+      addElementTriplets(trip, beamKPerClass[m.beamClass(e)], m.beamNodes[e][0], m.beamNodes[e][1]);
   for (int i = 0; i < m.numInterfaces(); ++i)
     addElementTriplets(trip, cohesive::elasticStiffness(law, m.ifaceGeom[i]), m.ifaceNodes[i][0], m.ifaceNodes[i][1]);
   SpMat K(m.numDofs(), m.numDofs());
@@ -142,7 +143,8 @@ double measureTransverseModulus(const CaseParams& p, double* blockStrain) {
 
 // --- set-up ---------------------------------------------------------------------------------------------
 Simulation::Simulation(const CaseParams& p)
-    : params(p), model(buildCrossply(geometryOf(p))) {
+    : params(p), model(coarsenFarField(buildCrossply(geometryOf(p)), static_cast<int>(p.far_field_slices),
+                                       p.full_half_height_over_d)) {
   const Model& m = model;
   const int n = m.numDofs();
   Materials& mat = materials;
@@ -155,29 +157,40 @@ Simulation::Simulation(const CaseParams& p)
 
   // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
   // Strengths drawn rod by rod, along each rod from its first slice (the realisation of a seed does not
-  // depend on how the model numbers its rod elements).
+  // depend on how the model numbers its rod elements). An element of the reduced far field spanning n
+  // slices takes the n draws of the full model's elements it stands for, and the weakest of them.
   {
-    const std::vector<double> draws = sampleRodStrengths(m.numBeams(), p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
+    std::size_t numDraws = 0;
+    for (int e = 0; e < m.numBeams(); ++e) numDraws += m.beamSpan[e];
+    const std::vector<double> draws = sampleRodStrengths(numDraws, p.sigma_ru(), p.cv, static_cast<std::uint64_t>(p.seed));
     std::vector<int> alongRods(m.numBeams());
     for (int e = 0; e < m.numBeams(); ++e) alongRods[e] = e;
     std::sort(alongRods.begin(), alongRods.end(), [&](int a, int b) {
       return std::make_pair(m.beamRod[a], m.beamNodes[a][0]) < std::make_pair(m.beamRod[b], m.beamNodes[b][0]);
     });
     mat.beamStrength.resize(m.numBeams());
-    for (int r = 0; r < m.numBeams(); ++r) mat.beamStrength[alongRods[r]] = draws[r];
+    std::size_t next = 0;
+    for (int r = 0; r < m.numBeams(); ++r) {
+      const int e = alongRods[r];
+      mat.beamStrength[e] = draws[next++];
+      for (int part = 1; part < m.beamSpan[e]; ++part) mat.beamStrength[e] = std::min(mat.beamStrength[e], draws[next++]);
+    }
   }
   if (!p.rods_breakable) std::fill(mat.beamStrength.begin(), mat.beamStrength.end(), INFINITY);
 
-  // Element matrices: all rods of a ply share one orientation, so one matrix per ply.
-  for (int ply = 0; ply < 2; ++ply) {
-    const Vec3 xb = m.beamLength * m.rodDirection(ply);
+  // Element matrices: all rods of a ply share one orientation, so one matrix per ply (and per span in a
+  // reduced far field: Model::beamClass).
+  for (int c = 0; c < m.numBeamClasses(); ++c) {
+    const int ply = c % 2;
+    const double L = m.beamLengthOfClass(c);
+    const Vec3 xb = L * m.rodDirection(ply);
     const beam::Mat3 R = beam::localFrame(Vec3::Zero(), xb);
     mat.beamK.push_back(beam::globalStiffness(section, Vec3::Zero(), xb));
     mat.beamMc.push_back(beam::globalConsistentMass(section, Vec3::Zero(), xb));
-    mat.beamMl.push_back(beam::rotateToGlobal(beam::lumpedMassDiagonal(section, m.beamLength).asDiagonal().toDenseMatrix(), R));
+    mat.beamMl.push_back(beam::rotateToGlobal(beam::lumpedMassDiagonal(section, L).asDiagonal().toDenseMatrix(), R));
     beam::Mat12 T = beam::Mat12::Zero();
     for (int blk = 0; blk < 4; ++blk) T.block<3, 3>(3 * blk, 3 * blk) = R;
-    mat.beamLocalForceOperator.push_back(beam::localStiffness(section, m.beamLength) * T);
+    mat.beamLocalForceOperator.push_back(beam::localStiffness(section, L) * T);
     mat.beamStressOperator.emplace_back();
     for (int r = 0; r < 5; ++r) mat.beamStressOperator.back().row(r) = mat.beamLocalForceOperator.back().row(beam::kStressRows[r]);
     mat.beamTorsionOperator.push_back(mat.beamLocalForceOperator.back().row(beam::kTorsionRow));
@@ -403,10 +416,10 @@ std::vector<int> findOverloadedBeams(const std::vector<double>& ratio, const std
 // and with a consistent mass the kinetic energy of the mass lumping 1/2 v^T (M_e,consistent - M_e,lumped) v.
 void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool consistentMass, State& s) {
   const int a = m.beamNodes[e][0], b = m.beamNodes[e][1];
-  const int ply = m.rodPly[m.beamRod[e]];
+  const int c = m.beamClass(e);
   const beam::Vec12 u = gatherElement(s.q, a, b), v = gatherElement(s.v, a, b);
-  s.rodFractureEnergy += 0.5 * u.dot(mat.beamK[ply] * u);
-  if (consistentMass) s.rodFractureEnergy += 0.5 * v.dot((mat.beamMc[ply] - mat.beamMl[ply]) * v);
+  s.rodFractureEnergy += 0.5 * u.dot(mat.beamK[c] * u);
+  if (consistentMass) s.rodFractureEnergy += 0.5 * v.dot((mat.beamMc[c] - mat.beamMl[c]) * v);
 }
 
 }  // namespace
@@ -490,7 +503,8 @@ int Simulation::countInelasticInterfaces() const {
 //   J = (1/B) [ - sum_{loaded nodes} F_y (du_y/dx)  +  W_right - W_left ]
 // with F_y the force the grips apply, du_y/dx = -/+ U / w_s on the top/bottom rows, and W the strain energy
 // per unit length in x at the free left and right faces (first slice: beams of the first segment over h_e,
-// interfaces of the end slice over their tributary h_e / 2).
+// interfaces of the end slice over their tributary h_e / 2; in a reduced far field an element spanning n
+// slices over n h_e, and an interface over the length along x it stands for, area / edge length).
 double Simulation::computeJ() const {
   const Model& m = model;
   const double U = state.appliedDisplacement;
@@ -499,22 +513,25 @@ double Simulation::computeJ() const {
     const double dudx = ops.prescribedShape[i] >= 0 ? -U / m.w_s : U / m.w_s;
     sumFdudx += state.reaction[i] * dudx;
   }
-  auto faceEnergyDensity = [&](int slice, int segment) {
-    double eb = 0, ei = 0;
+  // side 0: the left face (slice 0, the elements starting there); 1: the right face (the last slice)
+  auto faceEnergyDensity = [&](int slice, int side) {
+    double eb = 0, ebLong = 0, ei = 0;
     for (int e = 0; e < m.numBeams(); ++e) {
-      if (state.beamBroken[e] || m.nodeSlice[m.beamNodes[e][0]] != segment) continue;
+      if (state.beamBroken[e] || m.nodeSlice[m.beamNodes[e][side]] != slice) continue;
       const beam::Vec12 u = gatherElement(state.q, m.beamNodes[e][0], m.beamNodes[e][1]);
-      eb += 0.5 * u.dot(materials.beamK[m.rodPly[m.beamRod[e]]] * u);
+      const double energy = 0.5 * u.dot(materials.beamK[m.beamClass(e)] * u);
+      if (m.beamSpan[e] == 1) eb += energy;
+      else ebLong += energy / (m.beamSpan[e] * m.h_e);
     }
     for (int i = 0; i < m.numInterfaces(); ++i) {
       if (m.ifaceSlice[i] != slice) continue;
-      ei += m.ifaceGeom[i].area *
-            cohesive::storedEnergyDensity(materials.law, computeLocalOpening(m, state.q, i), state.lambdaMax[i]);
+      const double w = cohesive::storedEnergyDensity(materials.law, computeLocalOpening(m, state.q, i), state.lambdaMax[i]);
+      ei += m.hasFarField() ? m.ifaceEdgeLength[i] * w * (0.5 * m.h_e) : m.ifaceGeom[i].area * w;
     }
-    return eb / m.h_e + ei / (0.5 * m.h_e);
+    return eb / m.h_e + ebLong + ei / (0.5 * m.h_e);
   };
   const double Wleft = faceEnergyDensity(0, 0);
-  const double Wright = faceEnergyDensity(m.numSlices - 1, m.numSlices - 2);
+  const double Wright = faceEnergyDensity(m.numSlices - 1, 1);
   return (-sumFdudx + Wright - Wleft) / m.B;
 }
 

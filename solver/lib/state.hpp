@@ -46,14 +46,14 @@ struct Materials {
   bool rodsBreakable = true;
   std::string deletionRule;          // case key deletion_rule
   beam::RodStress rodStress = beam::RodStress::AxialBending;  // case key rod_stress
-  // per ply (all rods of a ply share one orientation): K_local T (u_e -> local end forces), and the global
-  // element stiffness, consistent mass and lumped mass
+  // per element class Model::beamClass (ply: all rods of a ply share one orientation; and span): K_local T
+  // (u_e -> local end forces), and the global element stiffness, consistent mass and lumped mass
   std::vector<beam::Mat12> beamLocalForceOperator, beamK, beamMc, beamMl;
-  // per ply: the rows beam::kStressRows of beamLocalForceOperator, all that the stress check needs
+  // per class: the rows beam::kStressRows of beamLocalForceOperator, all that the stress check needs
   std::vector<beam::StressOperator> beamStressOperator;
-  // per ply: beam::stressChangeBound of beamStressOperator (stress per unit of max |u_i| change)
+  // per class: beam::stressChangeBound of beamStressOperator (stress per unit of max |u_i| change)
   std::vector<double> beamStressChangeBound;
-  // per ply: the row beam::kTorsionRow of beamLocalForceOperator (the torque; read by rod_stress = principal only)
+  // per class: the row beam::kTorsionRow of beamLocalForceOperator (the torque; read by rod_stress = principal only)
   std::vector<Eigen::Matrix<double, 1, 12>> beamTorsionOperator;
   double omegaMaxElement = 0;        // largest beam-element frequency (consistent mass)
   double E_transverse = 0, c_d = 0;  // transverse modulus and wave speed

@@ -1,0 +1,138 @@
+"""The reduced far field (issue "Model only what a scene needs"; README "Reduced far field") against the full
+model at 80 x 80 d, theta_D = 30 (21.4, 10), `make bench-paper`'s variant (lumped, dt_factor 0.22, damping_cap
+0.5, static_start 0.95), 1 thread, to Delta_a = 30 d.
+
+    python3 -m studies.far_field.compare --run full=RUN_DIR --run m4_h22=RUN_DIR ...   # records from runs
+    python3 -m studies.far_field.compare --elastic BINARY      # the elastic table: static solves, ~5 min
+    python3 -m studies.far_field.compare                       # the report from the records
+
+Each run leaves a record (record_<name>.json: metrics and the whole R-curve, bench/experiments/check_100's
+format); the elastic table (elastic.json) holds, per far field, the static elastic solution's stiffness load/U
+and the first-damage displacement U_c against the full model's. README.md here is made from them, so the
+report regenerates without the runs (commands in README.md).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+from bench.experiments.check_100.compare import R_at, record_of
+from enamel_results import metrics
+from enamel_results.paths import PAPER_CASES
+
+HERE = pathlib.Path(__file__).resolve().parent
+CASE = "theta30_s21.4_e10_cv0"
+SIZE = ["w_s_over_d=80", "h_s_over_d=80"]
+VARIANT = ['integrator="lumped"', "dt_factor=0.22", "damping_cap=0.5", "threads=1"] + SIZE
+ELASTIC_FIELDS = [(1, 0), (2, 22), (4, 22), (8, 22)]   # (far_field_slices, full_half_height_over_d)
+
+
+def far_field_sets(slices: int, half_height: float) -> list[str]:
+    return [] if slices == 1 else [f"far_field_slices={slices}", f"full_half_height_over_d={half_height:g}"]
+
+
+def elastic_table(binary: pathlib.Path) -> list[dict]:
+    """Static elastic solutions (a run of one step with static_start 0.95): load/U and U_c per far field."""
+    import h5py
+    rows = []
+    for theta, case in ((0, "theta0_s21.4_e10_cv0"), (30, CASE)):
+        for slices, half in ELASTIC_FIELDS:
+            with tempfile.TemporaryDirectory() as tmp:
+                args = [str(binary), "run", str(PAPER_CASES / f"{case}.toml"), "--preset", "paper", "--out", tmp, "--quiet"]
+                for s in VARIANT + ["static_start=0.95", "max_steps=1"] + far_field_sets(slices, half):
+                    args += ["--set", s]
+                subprocess.run(args, check=True, capture_output=True, text=True)
+                with h5py.File(pathlib.Path(tmp) / "result.h5", "r") as f:
+                    m, h = f["meta"].attrs, f["history"]
+                    rows.append(dict(theta=theta, slices=slices, half_height=half, dof=int(m["dof"]),
+                                     stiffness=float(h["load"][0] / h["applied_displacement"][0]),
+                                     Uc=float(m["static_start_Uc_over_d"])))
+    return rows
+
+
+def elastic_report(rows: list[dict]) -> str:
+    lines = ["| theta_D | far field | DOF | load/U against full | U_c against full |", "|---|---|---|---|---|"]
+    for r in rows:
+        full = next(x for x in rows if x["theta"] == r["theta"] and x["slices"] == 1)
+        name = "full" if r["slices"] == 1 else f"every {r['slices']} slices beyond {r['half_height']:g} d"
+        lines.append(f"| {r['theta']} | {name} | {r['dof']} ({r['dof'] / full['dof']:.2f}) | "
+                     f"{r['stiffness'] / full['stiffness'] - 1:+.2%} | {r['Uc'] / full['Uc'] - 1:+.2%} |")
+    return "\n".join(lines)
+
+
+def run_report(records: dict) -> str:
+    full = records["full"]
+    fm = full["meta"]
+    lines = ["| model | status | DOF | steps | wall s | DOF-updates | speed-up (wall) | Delta_a max/d | R-curve L2 | R_init | "
+             "R/Gamma at 5, 10, 20 d | broken rods | KE/SE max |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, rec in records.items():
+        m = rec["meta"]
+        l2 = metrics.rcurve_rel_l2(np.array(full["da"]), np.array(full["R"]), np.array(rec["da"]), np.array(rec["R"]))
+        updates = m["dof"] * m["steps"]
+        lines.append(
+            f"| {name} | {m.get('status')} | {m['dof']} ({m['dof'] / fm['dof']:.2f}) | {m['steps']} | {m['wall_time_s']:.0f} | "
+            f"{updates:.3g} ({fm['dof'] * fm['steps'] / updates:.2f}x fewer) | {fm['wall_time_s'] / m['wall_time_s']:.2f} | "
+            f"{rec['da_max']:.2f} | {l2:.3g} ({'within' if l2 <= 0.02 else 'outside'} 2%) | "
+            f"{rec['R_init'] / full['R_init'] - 1:+.2%} | " + ", ".join(f"{R_at(rec, d):.2f}" for d in (5, 10, 20)) +
+            f" | {rec['broken_rods']} ({rec['broken_rods'] - full['broken_rods']:+d}) | "
+            f"{m.get('max_kinetic_over_strain_while_growing', math.nan):.3g} |")
+    cols = full["reach_at_da"]
+    lines += ["", "Inelastic reach from the crack plane (`/history/inelastic_reach_over_d`, d; half-height 40 d):", "",
+              "| Delta_a/d | " + " | ".join(f"{d:g}" for d, _ in cols) + " |", "|---|" + "---|" * len(cols)]
+    for name, rec in records.items():
+        cells = [f"{r:.1f}" for _, r in rec["reach_at_da"]] + ["-"] * (len(cols) - len(rec["reach_at_da"]))
+        lines.append(f"| {name} | " + " | ".join(cells[:len(cols)]) + " |")
+    return "\n".join(lines)
+
+
+def plot(records: dict, out: pathlib.Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    for (name, rec), style in zip(records.items(), ("-", "--", ":", "-.")):
+        ax.plot(rec["da"], rec["R"], style, label=name)
+    ax.set_xlabel(r"$\Delta a / d$")
+    ax.set_ylabel(r"$R / \Gamma_i$")
+    ax.set_title(r"80 x 80 d, $\theta_D$ = 30 (21.4, 10): full and reduced far field", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--run", action="append", default=[], metavar="NAME=RUN_DIR",
+                    help="a run's folder (writes record_NAME.json); NAME full is the reference")
+    ap.add_argument("--elastic", type=pathlib.Path, metavar="BINARY", help="compute the elastic table (elastic.json)")
+    ap.add_argument("--out", type=pathlib.Path, default=HERE, help="folder of the records and the report")
+    args = ap.parse_args(argv)
+    for item in args.run:
+        name, _, run = item.partition("=")
+        (args.out / f"record_{name}.json").write_text(json.dumps(record_of(pathlib.Path(run), name), indent=1) + "\n")
+    if args.elastic:
+        (args.out / "elastic.json").write_text(json.dumps(elastic_table(args.elastic), indent=1) + "\n")
+    paths = sorted(args.out.glob("record_*.json"), key=lambda p: (p.stem != "record_full", p.stem))
+    records = {p.stem[len("record_"):]: json.loads(p.read_text()) for p in paths}
+    if "full" not in records:
+        print("compare: missing record_full.json: run with --run full=RUN_DIR first", file=sys.stderr)
+        return 3
+    text = run_report(records)
+    if (args.out / "elastic.json").exists():
+        text += "\n\nElastic response (static solution before any damage), against the full model:\n\n"
+        text += elastic_report(json.loads((args.out / "elastic.json").read_text()))
+    plot(records, args.out / "rcurves.png")
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
