@@ -90,7 +90,7 @@ def test_far_field_report_regenerates_from_its_records(tmp_path):
     assert "| m4_h22 |" in r.stdout and "(outside 2%)" in r.stdout
     assert (tmp_path / "rcurves.png").stat().st_size > 1000
     full = json.loads((tmp_path / "record_full.json").read_text())
-    for p in tmp_path.glob("record_m*.json"):
+    for p in tmp_path.glob("record_*.json"):
         rec = json.loads(p.read_text())
         rec["da"], rec["R"] = full["da"], full["R"]
         p.write_text(json.dumps(rec))
