@@ -104,19 +104,6 @@ Model coarsenFarField(const Model& full, int slices, double fullHalfHeight) {
       cut = cut || cutAfter[n];
     }
   }
-  {  // in the order of their first node, as in the full model
-    std::vector<int> order(c.numBeams());
-    for (int e = 0; e < c.numBeams(); ++e) order[e] = e;
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return c.beamNodes[a][0] < c.beamNodes[b][0]; });
-    auto nodes = c.beamNodes;
-    auto rods = c.beamRod;
-    auto spans = c.beamSpan;
-    for (int e = 0; e < c.numBeams(); ++e) {
-      c.beamNodes[e] = nodes[order[e]];
-      c.beamRod[e] = rods[order[e]];
-      c.beamSpan[e] = spans[order[e]];
-    }
-  }
 
   // --- interfaces: grouped by the pair of kept nodes (and the periodic image) they land on ---
   struct Group {
@@ -124,7 +111,6 @@ Model coarsenFarField(const Model& full, int slices, double fullHalfHeight) {
     double area = 0, xLength = 0;
     Vec3 point = Vec3::Zero(), normal = Vec3::Zero();
   };
-  auto c0X = [&](int newNode) -> const Vec3& { return c.X[newNode]; };
   std::vector<Group> groups;
   std::map<std::tuple<int, int, int>, int> groupOf;
   for (int i = 0; i < nI; ++i) {
@@ -140,7 +126,7 @@ Model coarsenFarField(const Model& full, int slices, double fullHalfHeight) {
     g.area += geo.area;
     g.xLength += geo.area / f.ifaceEdgeLength[i];
     // the point moves with its two rods (by the mean of their shifts from slice k to the target slice)
-    const Vec3 shiftA = c0X(a) - f.X[f.ifaceNodes[i][0]], shiftB = c0X(b) - f.X[f.ifaceNodes[i][1]];
+    const Vec3 shiftA = c.X[a] - f.X[f.ifaceNodes[i][0]], shiftB = c.X[b] - f.X[f.ifaceNodes[i][1]];
     g.point += geo.area * (f.X[f.ifaceNodes[i][0]] + geo.armA + 0.5 * (shiftA + shiftB));
     g.normal += geo.area * geo.frame.row(0).transpose();
   }
@@ -175,6 +161,7 @@ Model coarsenFarField(const Model& full, int slices, double fullHalfHeight) {
     c.ifaceGeom.push_back(geo);
     c.ifaceEdgeLength.push_back(g.area / g.xLength);  // area / the length along x it stands for
   }
+  numberNodesBySlice(c);  // nodes already in slice order; the rod elements in the order of their first node
   return c;
 }
 

@@ -116,7 +116,6 @@ std::vector<VoronoiCell> computeSliceVoronoi(const std::vector<Vec2>& points, do
   return cells;
 }
 
-namespace {
 // Renumber the nodes slice by slice (within a slice in their order of creation: by ply, rod), so that the
 // nodes of a slice, which its interfaces join, are contiguous in memory, and the rod elements in the order of
 // their first node: the force kernels work slice by slice on data that stays in cache, and a loop over rod
@@ -152,8 +151,6 @@ void numberNodesBySlice(Model& m) {
   for (int& n : m.topNodes) n = newId[n];
   for (int& n : m.bottomNodes) n = newId[n];
 }
-}  // namespace
-
 Model buildCrossply(const GeometryParams& p) {
   if (!(p.theta_deg >= 0 && p.theta_deg <= 45)) throw std::invalid_argument("theta_D must be in [0, 45] deg");
   if (!(p.h_e > 0 && p.h_e <= 1)) throw std::invalid_argument("h_e must be in (0, 1] d");

@@ -130,4 +130,8 @@ std::vector<VoronoiCell> computeSliceVoronoi(const std::vector<Vec2>& points, do
 /// Build the whole crossply specimen. Throws std::invalid_argument on impossible parameters.
 Model buildCrossply(const GeometryParams& p);
 
+/// Number the nodes slice by slice and the rod elements in the order of their first node (what the force
+/// kernels rely on); interfaces keep their order. buildCrossply and coarsenFarField end with it.
+void numberNodesBySlice(Model& m);
+
 }  // namespace enamel
