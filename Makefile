@@ -24,6 +24,8 @@
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
 #                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
 #                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
+#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (issue 16; 6 runs, ~3 h on 2
+#                       cores, resumable; FF_RUNS="cv03_full cv03_m2_h22" for some): studies/far_field/record_*.json
 #   make identify       [IDENTIFY_ARGS=...]  issue 17's interface-ductility study: niced resumable runs in
 #                       runs/identify/, report studies/identify/results.md (studies/identify/README.md)
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
@@ -73,7 +75,7 @@ endif
 FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
-.PHONY: bench bench-paper identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
+.PHONY: bench bench-paper bench-far-field identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
   vtk reference clean-runs check-preset slurm
 
 help:
@@ -120,6 +122,11 @@ identify: $(ENAMEL)
 
 bench-paper: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)
+
+# Issue 16: full and reduced far field of the same cases, one run each, JOBS at a time (studies/far_field/README.md).
+FF_RUNS ?=
+bench-far-field: $(ENAMEL)
+	$(PYTHON) -m studies.far_field.compare --run-all $(ENAMEL) --jobs $(JOBS) $(if $(FF_RUNS),--only $(FF_RUNS))
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.

@@ -97,3 +97,35 @@ def test_far_field_report_regenerates_from_its_records(tmp_path):
     r = run()
     assert r.returncode == 0, r.stderr
     assert "(outside 2%)" not in r.stdout
+
+
+def test_far_field_study_runs_resume_and_record(ci_run, tmp_path):
+    """`make bench-far-field` (compare --run-all): a run whose result.h5 exists is not run again but recorded (with
+    its case, so each case is held against its own full model); a missing one is run with the study's variant and
+    far field, and one that fails is reported and leaves no record."""
+    import json
+    import os
+    import shutil
+    import subprocess
+    import sys
+    from conftest import ROOT
+    done = tmp_path / "runs" / "far_field" / "full"
+    done.mkdir(parents=True)
+    shutil.copy(ci_run(CASE), done / "result.h5")
+    fake = tmp_path / "fake-enamel"
+    fake.write_text("#!/bin/sh\necho \"$@\" > \"$(dirname \"$0\")/args.txt\"\nexit 10\n")
+    fake.chmod(0o755)
+    out = tmp_path / "report"
+    out.mkdir()
+    r = subprocess.run([sys.executable, "-m", "studies.far_field.compare", "--run-all", str(fake), "--jobs", "1",
+                        "--only", "full", "cv03_m2_h22", "--out", str(out)], capture_output=True, text=True,
+                       cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=300)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "full: done already" in r.stdout and "1 run(s) did not complete" in r.stderr
+    record = json.loads((out / "record_full.json").read_text())
+    assert record["case"] == CASE and record["meta"]["status"] == "completed"
+    assert not (out / "record_cv03_m2_h22.json").exists()
+    args = (tmp_path / "args.txt").read_text().split()
+    assert "theta30_s28.5_e10_cv0.3_seed1.toml" in args[1] and "--resume" in args
+    for s in ("far_field_slices=2", "full_half_height_over_d=22", "static_start=0.95", "w_s_over_d=80", "threads=1"):
+        assert s in args

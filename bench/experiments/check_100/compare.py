@@ -33,7 +33,7 @@ def result_file(run_dir: pathlib.Path) -> pathlib.Path:
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
-    r = results.load_result(result_file(run_dir), case="theta30_s21.4_e10_cv0")
+    r = results.load_result(result_file(run_dir))  # the case from /meta's case_source
     m = r.meta
     keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt",
             "max_kinetic_over_strain_while_growing", "peak_memory_mb", "git_hash", "static_start")
@@ -46,7 +46,7 @@ def record_of(run_dir: pathlib.Path, name: str) -> dict:
     scene = [(float(d), float(reach[np.argmax(da_h >= d)])) for d in (0.0, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
     # the step at which the crack first reached each Delta_a (0: its start), for the steps saved at equal advance
     steps_at = [(float(d), int(step_h[np.argmax(da_h >= d)])) for d in (1e-9, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
-    return dict(name=name, meta=meta,
+    return dict(name=name, case=r.case, meta=meta,
                 R_init=r.R_init, R_ss=r.R_ss, R_m=r.R_m, da_max=r.da_max, broken_rods=r.broken_rods,
                 warnings=str(m.get("warnings", "")), reach_at_da=scene, steps_at_da=steps_at,
                 da=[float(f"{x:.10g}") for x in r.da], R=[float(f"{x:.10g}") for x in r.R])
