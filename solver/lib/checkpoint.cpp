@@ -14,11 +14,12 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 6;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 7;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
                                        // the record's static elastic start; 5: history rows hold the kinetic
                                        // energy beyond the loading's motion; 6: ... and the inelastic zone's
-                                       // reach, the record its edge warning
+                                       // reach, the record its edge warning; 7: the static start
+                                       // records whether the model held a mechanism
 
 struct Writer {
   std::ofstream out;

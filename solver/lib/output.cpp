@@ -253,7 +253,9 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
            "static elastic solution at applied displacement static_start_U_over_d = static_start x "
            "static_start_Uc_over_d, moving at the loading's quasi-static velocity; static_start_Uc_over_d is the "
            "applied displacement at which the first interface reaches delta0 or the first rod element its "
-           "strength (static_start_limited_by), static_start_solve_s the wall time of the static solve. "
+           "strength (static_start_limited_by), static_start_solve_s the wall time of the static solve, "
+           "static_start_mechanism 1 when the elastic stiffness was singular (a part free to move without strain, "
+           "e.g. a rod end the pre-crack's cut leaves on one interface, kept where it was). "
            "static_start = 0: the run started from rest (U_c not computed: NaN)");
       attr(g.id, "static_start_Uc_over_d", st.firstDamageDisplacement);
       attr(g.id, "static_start_U_over_d", st.displacement);
@@ -261,6 +263,7 @@ void writeResultFile(const std::string& path, const Simulation& sim, const RunRe
       attr(g.id, "static_start_limited_by",
            st.fraction > 0 ? (st.limitedByRod ? "rod element strength" : "interface delta0") : "");
       attr(g.id, "static_start_solve_s", st.solveSeconds);
+      attr(g.id, "static_start_mechanism", static_cast<long>(st.mechanism));
     }
     // --- /rcurve ---
     {

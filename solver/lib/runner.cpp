@@ -114,10 +114,11 @@ class RunLoop {
     StaticStart& st = rec_.staticStart;
     st.solveSeconds = std::chrono::duration<double>(clock::now() - t0).count();
     std::fprintf(stderr, "enamel-dem: static elastic start at U/d = %.6g, %g of the first-damage displacement "
-                         "U_c/d = %.6g (%s), t = %.6g: skipped ~%.0f steps; static solve %.1f s\n",
+                         "U_c/d = %.6g (%s), t = %.6g: skipped ~%.0f steps; static solve %.1f s%s\n",
                  st.displacement, st.fraction, st.firstDamageDisplacement,
                  st.limitedByRod ? "a rod element's strength" : "an interface's delta0", st.time,
-                 st.time / sim_.integrator->timeStep(), st.solveSeconds);
+                 st.time / sim_.integrator->timeStep(), st.solveSeconds,
+                 st.mechanism ? " (the stiffness was singular: a part free to move without strain kept in place)" : "");
   }
 
   /// Fault injection for the tests of the failure path (RunOptions::injectNanAtStep): a NaN in one free

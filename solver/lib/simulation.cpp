@@ -63,7 +63,9 @@ SpMat assembleBeams(const Model& m, const std::vector<beam::Mat12>& perClass, in
 }  // namespace
 
 // --- static elastic solutions (verification, transverse modulus) ----------------------------------------
-VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values) {
+VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values,
+                           bool* mechanism) {
+  if (mechanism) *mechanism = false;
   const int n = static_cast<int>(K.rows());
   std::vector<double> uPres(n, 0.0);
   std::vector<int> freeIdx(n, 0);
@@ -82,9 +84,27 @@ VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const s
     }
   SpMat Kff(nf, nf);
   Kff.setFromTriplets(tff.begin(), tff.end());
-  Eigen::CholmodSupernodalLLT<SpMat> chol(Kff);
-  if (chol.info() != Eigen::Success) throw std::runtime_error("static solve: stiffness factorisation failed");
-  const VecX uf = chol.solve(rhs);
+  Eigen::CholmodSupernodalLLT<SpMat> chol;
+  chol.cholmod().print = 0;  // a factorisation that fails is handled below, not printed
+  chol.compute(Kff);
+  VecX uf;
+  if (chol.info() == Eigen::Success) {
+    uf = chol.solve(rhs);
+  } else {
+    // K_ff only semi-definite: a part of the model is a mechanism (e.g. a rod end that the pre-crack's cut
+    // leaves on a single interface, free to turn about it; the explicit schemes carry it on its mass). The
+    // prescribed displacements do no work on a mechanism (the right-hand side is orthogonal to K's null
+    // space), so any solution serves: factor K_ff + s I with s = 1e-10 of its largest diagonal entry (the
+    // mechanism then stays where it is) and refine against K_ff itself, which removes the shift's error from
+    // every mode with stiffness (each refinement multiplies it by s / (lambda + s)).
+    const double shift = 1e-10 * Kff.diagonal().cwiseAbs().maxCoeff();
+    chol.setShift(shift);
+    chol.factorize(Kff);
+    if (chol.info() != Eigen::Success) throw std::runtime_error("static solve: stiffness factorisation failed");
+    uf = chol.solve(rhs);
+    for (int it = 0; it < 4; ++it) uf += chol.solve(rhs - Kff * uf);
+    if (mechanism) *mechanism = true;
+  }
   VecX u(n);
   for (int i = 0; i < n; ++i) u[i] = freeIdx[i] >= 0 ? uf[freeIdx[i]] : uPres[i];
   return u;
@@ -295,7 +315,7 @@ int threadCount() {
 #endif
 }
 
-void Simulation::solveStaticElastic(double U) {
+void Simulation::solveStaticElastic(double U, bool* mechanism) {
   stressSchedule_ = StressCheckSchedule{};  // q is replaced: the next deletion check computes every element
   const SpMat Kt = assembleElasticStiffness(model, materials.beamK, &state.beamBroken, materials.law);
   std::vector<int> dofs = ops.prescribedDofs;
@@ -304,7 +324,7 @@ void Simulation::solveStaticElastic(double U) {
   const int anchor = model.bottomNodes[0];  // against rigid translation in x and z
   dofs.insert(dofs.end(), {6 * anchor, 6 * anchor + 2});
   values.insert(values.end(), {0.0, 0.0});
-  state.q = solveStaticPrescribed(Kt, dofs, values);
+  state.q = solveStaticPrescribed(Kt, dofs, values, mechanism);
   state.v.setZero();
   state.a.setZero();
   state.vHalf.setZero();
@@ -363,7 +383,7 @@ void setQuasiStaticState(const Operators& ops, const Loading& loading, const Vec
 StaticStart Simulation::startFromStaticElastic(double fraction) {
   StaticStart st;
   st.fraction = fraction;
-  solveStaticElastic(1.0);
+  solveStaticElastic(1.0, &st.mechanism);
   const VecX q1 = state.q, reaction1 = state.reaction;
   st.firstDamageDisplacement = computeFirstDamageDisplacement(model, materials, q1, state.beamBroken,
                                                               params.interfaces_breakable, st.limitedByRod);

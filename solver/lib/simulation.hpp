@@ -35,6 +35,8 @@ struct StaticStart {
   double displacement = 0;               // U* = fraction x U_c, where the run starts
   double time = 0;                       // t*: Loading::displacement(t*) = U*
   bool limitedByRod = false;             // U_c set by a rod element's strength (else by an interface)
+  bool mechanism = false;                // the elastic stiffness was singular: a part free to move without
+                                         // strain (solveStaticPrescribed) stayed where it was
   double solveSeconds = 0;               // wall time of the static solve and the start state (set by the runner)
 };
 
@@ -75,7 +77,7 @@ class Simulation {
   void replayDeletions();
   /// Replace the state by the static elastic solution at applied displacement U (intact interfaces elastic,
   /// deleted rods left out) and set the reactions: the reference for J and compliance checks.
-  void solveStaticElastic(double U);
+  void solveStaticElastic(double U, bool* mechanism = nullptr);
   /// Static elastic start (case key static_start = fraction > 0): the static elastic solution q1 at U = 1,
   /// U_c (computeFirstDamageDisplacement), U* = fraction U_c, t* with U(t*) = U*; then the quasi-static state
   /// of the loading at t*: q = U* q1, v = U'(t*) q1, a = U''(t*) q1, time t*, each interface's history at its
@@ -107,7 +109,10 @@ class Simulation {
 /// rows displaced by +/- delta/2, everything else free (one node fixed in x and z against rigid motion).
 double measureTransverseModulus(const CaseParams& p, double* blockStrain = nullptr);
 
-/// Static solution of K u = 0 with u prescribed (= values) at `dofs` (CHOLMOD on the free partition).
-VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values);
+/// Static solution of K u = 0 with u prescribed (= values) at `dofs` (CHOLMOD on the free partition). Where
+/// the free partition is only semi-definite (a mechanism: a part free to move without straining anything),
+/// the mechanism stays where it is and `mechanism`, if given, is set.
+VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values,
+                           bool* mechanism = nullptr);
 
 }  // namespace enamel
