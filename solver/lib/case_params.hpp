@@ -120,6 +120,10 @@ enum class Need { required, optional };
     X(full_half_height_over_d, Real, numerics, optional, 0, "[]", 0, 1000, "", "d",                                 \
       "full band half-height: of the reduced far field (far_field_slices > 1): every slice is kept within this "    \
       "distance of the crack plane; at least 1 d")                                                                  \
+    X(far_field_rod_breaks, Choice, numerics, optional, "stop", "[]", 0, 0, "stop|allow", "-",                     \
+      "reduced far field: a rod element deleted within 2 d of the band's edge or beyond it stops the run (stop), "  \
+      "or is allowed and recorded as a warning (allow: the far field's element of m slices, with the weakest "      \
+      "strength of its parts, breaks whole); interfaces past delta0 there always stop it")                          \
     X(zeta, Real, numerics, optional, 0.2, "[]", 0, 1, "", "-",                                                     \
       "Rayleigh damping: damping ratio at w_min = pi c_d / h_s (C = a M + b K)")                                    \
     X(dt_factor, Real, numerics, optional, 0.1, "(]", 0, 1, "", "smallest element period",                          \

@@ -14,12 +14,13 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 7;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 8;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
                                        // the record's static elastic start; 5: history rows hold the kinetic
                                        // energy beyond the loading's motion; 6: ... and the inelastic zone's
                                        // reach, the record its edge warning; 7: the static start
-                                       // records whether the model held a mechanism
+                                       // records whether the model held a mechanism; 8: the record its
+                                       // far-field rod break warning
 
 struct Writer {
   std::ofstream out;
@@ -102,7 +103,7 @@ void transferFields(Io& io, S& s, R& rec) {
   });
   io.str(rec.status); io.str(rec.stopReason);
   io.pod(rec.wallSeconds); io.pod(rec.steps); io.pod(rec.maxKineticRatio);
-  io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic); io.pod(rec.warnedEdge);
+  io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic); io.pod(rec.warnedEdge); io.pod(rec.warnedFarFieldRod);
   io.items(rec.warnings, [&](auto& w) { io.str(w); });
   io.pod(rec.staticStart);
 }

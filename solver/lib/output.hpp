@@ -35,6 +35,7 @@ struct RunRecord {
   std::vector<std::string> warnings;      // quasi-static checks that left their bounds
   double maxKineticRatio = 0;             // largest kinetic / strain energy while the crack grew
   bool warnedBalance = false, warnedKinetic = false, warnedEdge = false;  // each warning is recorded once
+  bool warnedFarFieldRod = false;
   StaticStart staticStart;                // what the static elastic start did (fraction 0: from rest)
 };
 

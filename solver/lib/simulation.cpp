@@ -502,14 +502,26 @@ int Simulation::countFailedInterfaces() const {
 // delta0 and the deleted rod elements, each at the midpoint of its two nodes' reference positions (0 while
 // everything is elastic). The runner warns when it comes near the loaded edges (the R-curve then depends on
 // the specimen's height: studies/scene/README.md).
-double Simulation::inelasticReach() const {
-  const Model& m = model;
-  auto distance = [&](const std::array<int, 2>& n) { return std::abs(0.5 * (m.X[n[0]].y() + m.X[n[1]].y()) - m.yCrack); };
+double Simulation::inelasticReach() const { return std::max(inelasticInterfaceReach(), brokenRodReach()); }
+
+namespace {
+double distanceFromCrackPlane(const Model& m, const std::array<int, 2>& n) {
+  return std::abs(0.5 * (m.X[n[0]].y() + m.X[n[1]].y()) - m.yCrack);
+}
+}  // namespace
+
+double Simulation::inelasticInterfaceReach() const {
   double reach = 0;
-  for (int i = 0; i < m.numInterfaces(); ++i)
-    if (cohesive::isInelastic(materials.law, state.lambdaMax[i])) reach = std::max(reach, distance(m.ifaceNodes[i]));
-  for (int e = 0; e < m.numBeams(); ++e)
-    if (state.beamBroken[e]) reach = std::max(reach, distance(m.beamNodes[e]));
+  for (int i = 0; i < model.numInterfaces(); ++i)
+    if (cohesive::isInelastic(materials.law, state.lambdaMax[i]))
+      reach = std::max(reach, distanceFromCrackPlane(model, model.ifaceNodes[i]));
+  return reach;
+}
+
+double Simulation::brokenRodReach() const {
+  double reach = 0;
+  for (int e = 0; e < model.numBeams(); ++e)
+    if (state.beamBroken[e]) reach = std::max(reach, distanceFromCrackPlane(model, model.beamNodes[e]));
   return reach;
 }
 

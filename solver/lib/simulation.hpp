@@ -95,7 +95,9 @@ class Simulation {
   double fractureEnergyOfInterfaces() const;
   int countFailedInterfaces() const;
   int countInelasticInterfaces() const;
-  double inelasticReach() const;
+  double inelasticReach() const;           // the larger of the two below
+  double inelasticInterfaceReach() const;  // interfaces past delta0
+  double brokenRodReach() const;           // deleted rod elements
   /// The deletion check's schedule (its `computed` count: elements computed at the last step).
   const StressCheckSchedule& stressCheckSchedule() const { return stressSchedule_; }
 

@@ -24,7 +24,7 @@ import tempfile
 
 import numpy as np
 
-from bench.experiments.check_100.compare import R_at, record_of
+from bench.experiments.check_100.compare import R_at, record_of, result_file
 from enamel_results import metrics
 from enamel_results.paths import PAPER_CASES
 
@@ -49,6 +49,7 @@ RUNS = {
     "m4_h22": (CASE, far_field_sets(4, 22)),
     "cv03_full": (CV_CASE, []),
     "cv03_m2_h22": (CV_CASE, far_field_sets(2, 22)),  # stops at Delta_a = 1.95 d: a rod breaks 23 d from the plane
+    "cv03_m2_h22_allow": (CV_CASE, far_field_sets(2, 22) + ['far_field_rod_breaks="allow"']),
 }
 RUNS_DIR = pathlib.Path("runs") / "far_field"
 
@@ -128,6 +129,37 @@ def by_case(records: dict) -> dict:
     return out
 
 
+def scene_of(run_dir: pathlib.Path) -> dict:
+    """Where the damage is at the run's last frame (issue 16, item 1): the distances from the crack plane of the
+    deleted rod elements (sorted) and of the interfaces with damage > 0 (largest, 99th percentile)."""
+    import h5py
+    with h5py.File(result_file(run_dir), "r") as f:
+        g, frames = f["geometry"], f["frames"]
+        last = frames[max(frames.keys(), key=int)]
+        X, y_crack = g["node_position"][:], float(g.attrs["y_crack_plane"])
+        nodes = g["beam_nodes"][:]
+        mid_y = 0.5 * (X[nodes[:, 0], 1] + X[nodes[:, 1], 1])
+        rods = np.sort(np.abs(mid_y[last["beam_broken"][:].astype(bool)] - y_crack))
+        damaged = np.abs(g["iface_midpoint"][:, 1][last["iface_damage"][:] > 0] - y_crack)
+    return dict(broken_rod_distances=[round(float(d), 2) for d in rods],
+                damaged_interface_reach=float(damaged.max()) if damaged.size else 0.0,
+                damaged_interface_reach_p99=float(np.percentile(damaged, 99)) if damaged.size else 0.0)
+
+
+def scene_report(records: dict) -> str:
+    """Per record that holds it: how far from the plane the damaged interfaces and the broken rods lie."""
+    lines = ["| run | damaged interfaces: farthest, 99% within (d) | broken rods within 2, 5, 10, 20 d, beyond 20 d | "
+             "the farthest broken rods (d) |", "|---|---|---|---|"]
+    for name, rec in records.items():
+        if "broken_rod_distances" not in rec:
+            continue
+        d = np.array(rec["broken_rod_distances"])
+        counts = [int((d <= r).sum()) for r in (2, 5, 10, 20)] + [int((d > 20).sum())]
+        lines.append(f"| {name} | {rec['damaged_interface_reach']:.1f}, {rec['damaged_interface_reach_p99']:.1f} | "
+                     + ", ".join(map(str, counts)) + " | " + ", ".join(f"{x:.1f}" for x in d[-6:]) + " |")
+    return "\n".join(lines) if len(lines) > 2 else ""
+
+
 def run_report(records: dict) -> str:
     """One table per case against that case's full model, then the inelastic reach of every run."""
     lines = []
@@ -193,12 +225,15 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.run_all:
         failed = run_all(args.run_all, args.only, args.jobs)
-        args.run += [f"{n}={RUNS_DIR / n}" for n in args.only if (RUNS_DIR / n / "result.h5").exists()]
+        args.run += [f"{n}={RUNS_DIR / n}" for n in args.only
+                     if (RUNS_DIR / n / "result.h5").exists() or (RUNS_DIR / n / "result.failed.h5").exists()]
         if failed:
             print(f"compare: {failed} run(s) did not complete; their records are not written", file=sys.stderr)
     for item in args.run:
         name, _, run = item.partition("=")
-        (args.out / f"record_{name}.json").write_text(json.dumps(record_of(pathlib.Path(run), name), indent=1) + "\n")
+        record = record_of(pathlib.Path(run), name)
+        record.update(scene_of(pathlib.Path(run)))
+        (args.out / f"record_{name}.json").write_text(json.dumps(record, indent=1) + "\n")
     if args.elastic:
         (args.out / "elastic.json").write_text(json.dumps(elastic_table(args.elastic), indent=1) + "\n")
     paths = sorted(args.out.glob("record_*.json"))
@@ -207,6 +242,8 @@ def main(argv=None) -> int:
         print("compare: missing record_full.json: run with --run full=RUN_DIR first", file=sys.stderr)
         return 3
     text = run_report(records)
+    if scene_report(records):
+        text += "\n\nWhere the damage is at the last frame (distance from the crack plane):\n\n" + scene_report(records)
     if (args.out / "elastic.json").exists():
         text += "\n\nElastic response (static solution before any damage), against the full model:\n\n"
         text += elastic_report(json.loads((args.out / "elastic.json").read_text()))

@@ -60,6 +60,25 @@ def test_inelastic_zone_at_the_band_edge_stops_the_run(run, tmp_path):
         assert f["geometry"].attrs["far_field_slices"] == 2
 
 
+def test_far_field_rod_breaks_allowed_are_recorded_and_interfaces_still_stop(run, tmp_path):
+    """far_field_rod_breaks = allow: a rod element broken near the band's edge (weak rods: mean strength 8 sigma0,
+    cv 0.5) is a warning in /meta instead of the stop, and the run goes on until the interfaces past delta0 come
+    near the edge, which still stops it; the default (stop) stops at the rod break."""
+    sets = ["sigma_ru_over_sigma0=8", "cv=0.5", "far_field_slices=2", "full_half_height_over_d=3.5"]
+    stop, allow = tmp_path / "stop", tmp_path / "allow"
+    r = run_ci(run, stop, *sets)
+    assert r.returncode == 10 and "inelastic zone reached" in r.stderr, r.stderr
+    r = run_ci(run, allow, *sets, 'far_field_rod_breaks="allow"')
+    assert r.returncode == 10 and "interfaces past delta0 reached" in r.stderr, r.stderr
+    with h5py.File(stop / "result.failed.h5", "r") as fs, h5py.File(allow / "result.failed.h5", "r") as fa:
+        assert "a rod element broke" not in fs["meta"].attrs["warnings"]
+        assert "a rod element broke" in fa["meta"].attrs["warnings"] and "far_field_rod_breaks = allow" in fa["meta"].attrs["warnings"]
+        assert fa["meta"].attrs["steps"] > fs["meta"].attrs["steps"]
+        assert fa["history/broken_rod_elements"][-1] > fs["history/broken_rod_elements"][-1] > 0
+        reach = fa["history/inelastic_reach_over_d"][:]  # rods included: past the limit rows before the stop
+        assert (reach > 3.5 - 2).any() and np.argmax(reach > 3.5 - 2) < len(reach) - 1
+
+
 def test_far_field_without_its_band_is_refused(run, tmp_path):
     out = tmp_path / "bad"
     r = run_ci(run, out, "far_field_slices=4")

@@ -27,9 +27,12 @@ NAMES = ("rest", "static")
 
 
 def result_file(run_dir: pathlib.Path) -> pathlib.Path:
-    """result.h5, or result.partial.h5 of a run stopped by Ctrl-C (its status then says interrupted)."""
-    done = pathlib.Path(run_dir) / "result.h5"
-    return done if done.exists() else pathlib.Path(run_dir) / "result.partial.h5"
+    """result.h5, or result.partial.h5 of a run stopped by Ctrl-C (its status then says interrupted), or
+    result.failed.h5 of a run that stopped itself (status failed)."""
+    for name in ("result.h5", "result.partial.h5", "result.failed.h5"):
+        if (pathlib.Path(run_dir) / name).exists():
+            return pathlib.Path(run_dir) / name
+    return pathlib.Path(run_dir) / "result.h5"
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
