@@ -48,6 +48,7 @@ RUNS = {
     "m2_h22": (CASE, far_field_sets(2, 22)),
     "m4_h22": (CASE, far_field_sets(4, 22)),
     "cv03_full": (CV_CASE, []),
+    "cv03_full_dt0.2": (CV_CASE, ["dt_factor=0.2"]),
     "cv03_m2_h22": (CV_CASE, far_field_sets(2, 22)),  # stops at Delta_a = 1.95 d: a rod breaks 23 d from the plane
     "cv03_m2_h22_allow": (CV_CASE, far_field_sets(2, 22) + ['far_field_rod_breaks="allow"']),
 }
