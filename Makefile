@@ -24,7 +24,7 @@
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
 #                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
 #                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
-#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (issue 16; 6 runs, ~3 h on 2
+#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (issue 16; 8 runs, ~3 h on 2
 #                       cores, resumable; FF_RUNS="cv03_full cv03_m2_h22" for some): studies/far_field/record_*.json
 #   make identify       [IDENTIFY_ARGS=...]  issue 17's interface-ductility study: niced resumable runs in
 #                       runs/identify/, report studies/identify/results.md (studies/identify/README.md)
