@@ -179,25 +179,27 @@ class RunLoop {
     // cannot soften apart, and its rod elements stand for m slices each (far_field_rod_breaks = allow lets
     // them break whole, with a warning; interfaces past delta0 there always stop the run).
     const Model& m = sim_.model;
-    const bool rodBreaksAllowed = p_.far_field_rod_breaks == "allow";
-    const double bandReach = m.hasFarField() && rodBreaksAllowed ? sim_.inelasticInterfaceReach() : r.inelasticReach;
-    if (m.hasFarField() && rodBreaksAllowed && !rec_.warnedFarFieldRod && r.inelasticReach > m.fullHalfHeight - kEdgeWarnDistance &&
-        bandReach <= m.fullHalfHeight - kEdgeWarnDistance) {
-      rec_.warnedFarFieldRod = true;
-      rec_.warnings.push_back(fmt("a rod element broke %.3g d from the crack plane at step %.0f (Delta_a %.3g d), ",
-                                  sim_.brokenRodReach(), s.step, s.crackAdvance) +
-                              fmt("within %.2g d of the full band's edge or beyond it (full_half_height_over_d = %g): "
-                                  "allowed (far_field_rod_breaks = allow), its far-field element of up to %.0f slices "
-                                  "broke whole", kEdgeWarnDistance, m.fullHalfHeight, double(m.farFieldSlices)));
+    const double bandEdge = m.fullHalfHeight - kEdgeWarnDistance;
+    if (m.hasFarField() && r.inelasticReach > bandEdge) {
+      const bool rodBreaksAllowed = p_.far_field_rod_breaks == "allow";
+      const double interfaceReach = rodBreaksAllowed ? sim_.inelasticInterfaceReach() : r.inelasticReach;
+      if (interfaceReach > bandEdge || !rodBreaksAllowed)
+        return fail(fmt(rodBreaksAllowed ? "interfaces past delta0 reached %.3g d from the crack plane at step %.0f "
+                                           "(Delta_a %.3g d), "
+                                         : "inelastic zone reached %.3g d from the crack plane at step %.0f (Delta_a %.3g d), ",
+                        interfaceReach, s.step, s.crackAdvance) +
+                    fmt("within %.2g d of the edge of the full band (full_half_height_over_d = %g): the reduced far "
+                        "field (far_field_slices = %.0f) is no longer elastic there; rerun with a wider band",
+                        kEdgeWarnDistance, m.fullHalfHeight, double(m.farFieldSlices)));
+      if (!rec_.warnedFarFieldRod) {  // only rod elements out there, and allowed
+        rec_.warnedFarFieldRod = true;
+        rec_.warnings.push_back(fmt("a rod element broke %.3g d from the crack plane at step %.0f (Delta_a %.3g d), ",
+                                    sim_.brokenRodReach(), s.step, s.crackAdvance) +
+                                fmt("within %.2g d of the full band's edge or beyond it (full_half_height_over_d = %g): "
+                                    "allowed (far_field_rod_breaks = allow), its far-field element of up to %.0f slices "
+                                    "broke whole", kEdgeWarnDistance, m.fullHalfHeight, double(m.farFieldSlices)));
+      }
     }
-    if (m.hasFarField() && bandReach > m.fullHalfHeight - kEdgeWarnDistance)
-      return fail(fmt(rodBreaksAllowed ? "interfaces past delta0 reached %.3g d from the crack plane at step %.0f "
-                                         "(Delta_a %.3g d), "
-                                       : "inelastic zone reached %.3g d from the crack plane at step %.0f (Delta_a %.3g d), ",
-                      bandReach, s.step, s.crackAdvance) +
-                  fmt("within %.2g d of the edge of the full band (full_half_height_over_d = %g): the reduced far "
-                      "field (far_field_slices = %.0f) is no longer elastic there; rerun with a wider band",
-                      kEdgeWarnDistance, m.fullHalfHeight, double(m.farFieldSlices)));
     // The inelastic zone near the loaded edges: the R-curve may depend on the specimen's height.
     const double halfHeight = 0.5 * sim_.model.h_s;
     if (!rec_.warnedEdge && r.inelasticReach > halfHeight - kEdgeWarnDistance) {

@@ -55,6 +55,12 @@ RUNS = {
 RUNS_DIR = pathlib.Path("runs") / "far_field"
 
 
+def finished(name: str) -> pathlib.Path | None:
+    """The run's final result: result.h5, or result.failed.h5 of a run that stopped itself (the edge check's stop
+    is a measurement too); None while it has neither."""
+    return next((p for p in (RUNS_DIR / name / "result.h5", RUNS_DIR / name / "result.failed.h5") if p.exists()), None)
+
+
 def run_command(binary: pathlib.Path, name: str) -> list[str]:
     case, sets = RUNS[name]
     args = [str(binary), "run", str(PAPER_CASES / f"{case}.toml"), "--preset", "paper", "--out", str(RUNS_DIR / name),
@@ -66,20 +72,20 @@ def run_command(binary: pathlib.Path, name: str) -> list[str]:
 
 def run_all(binary: pathlib.Path, names: list[str], jobs: int) -> int:
     """Run the study's runs `jobs` at a time (niced; each resumes from its checkpoint, a finished one is skipped)
-    and return the number that did not complete."""
+    and return the number that left no final result."""
     from concurrent.futures import ThreadPoolExecutor
 
-    def one(name: str) -> int:
-        if (RUNS_DIR / name / "result.h5").exists():
-            print(f"far_field: {name}: done already ({RUNS_DIR / name / 'result.h5'})", flush=True)
-            return 0
+    def one(name: str) -> bool:
+        if finished(name):
+            print(f"far_field: {name}: done already ({finished(name)})", flush=True)
+            return True
         print(f"far_field: {name}: " + " ".join(run_command(binary, name)), flush=True)
         rc = subprocess.run(["nice", "-n", "10"] + run_command(binary, name)).returncode
         print(f"far_field: {name}: exit {rc}", flush=True)
-        return rc
+        return finished(name) is not None
 
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        return sum(rc != 0 for rc in pool.map(one, names))
+        return sum(not done for done in pool.map(one, names))
 
 
 def elastic_table(binary: pathlib.Path) -> list[dict]:
@@ -226,8 +232,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.run_all:
         failed = run_all(args.run_all, args.only, args.jobs)
-        args.run += [f"{n}={RUNS_DIR / n}" for n in args.only
-                     if (RUNS_DIR / n / "result.h5").exists() or (RUNS_DIR / n / "result.failed.h5").exists()]
+        args.run += [f"{n}={RUNS_DIR / n}" for n in args.only if finished(n)]
         if failed:
             print(f"compare: {failed} run(s) did not complete; their records are not written", file=sys.stderr)
     for item in args.run:
@@ -243,8 +248,9 @@ def main(argv=None) -> int:
         print("compare: missing record_full.json: run with --run full=RUN_DIR first", file=sys.stderr)
         return 3
     text = run_report(records)
-    if scene_report(records):
-        text += "\n\nWhere the damage is at the last frame (distance from the crack plane):\n\n" + scene_report(records)
+    scene = scene_report(records)
+    if scene:
+        text += "\n\nWhere the damage is at the last frame (distance from the crack plane):\n\n" + scene
     if (args.out / "elastic.json").exists():
         text += "\n\nElastic response (static solution before any damage), against the full model:\n\n"
         text += elastic_report(json.loads((args.out / "elastic.json").read_text()))
