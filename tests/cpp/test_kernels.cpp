@@ -3,6 +3,7 @@
 // factorisation is a failed run, 11; a refused time step is bad input, 7); the inverse of the loading and the
 // static elastic start (case key static_start).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -164,6 +165,34 @@ TEST(Kernels, NodeBlockProductsEqualTheSparseProduct) {
   coupled.coeffRef(0, 2) += 1.0;  // ux of node 0 to its uz
   coupled.coeffRef(2, 0) += 1.0;
   EXPECT_TRUE(toNodeBlocks(SpMatRow(coupled)).split.empty());
+}
+
+// The position update (two DOFs at a time, maxima in pairs) gives the one-DOF-at-a-time loop's q bit for bit
+// and its exact maxima, on lengths that are and are not multiples of 6, with signs of both kinds, at 1 and 2
+// threads.
+TEST(Kernels, PositionUpdateEqualsTheScalarLoop) {
+  const int before = omp_get_max_threads();
+  for (int n : {6, 12, 600, 601, 605}) {
+    const VecX q0 = pseudoRandomField(n, 3.0) - VecX::Constant(n, 1.0), v = pseudoRandomField(n, 2.0).reverse();
+    const double dt = 0.0313;
+    VecX expected = q0;
+    double step = 0, value = 0;
+    for (int i = 0; i < n; ++i) {
+      const double s = dt * v[i];
+      expected[i] += s;
+      step = std::max(step, std::abs(s));
+      value = std::max(value, std::abs(expected[i]));
+    }
+    for (int threads : {1, 2}) {
+      omp_set_num_threads(threads);
+      VecX q = q0;
+      const PositionMove move = advancePositions(q, v, dt);
+      for (int i = 0; i < n; ++i) ASSERT_EQ(q[i], expected[i]) << "n " << n << ", DOF " << i;
+      EXPECT_EQ(move.largestStep, step) << "n " << n;
+      EXPECT_EQ(move.largestValue, value) << "n " << n;
+    }
+  }
+  omp_set_num_threads(before);
 }
 
 TEST(Kernels, FailedFactorisationIsARunFailure) {

@@ -47,6 +47,19 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
     assert "Fastest within the bound" in md or "No fast variant within the bound" in md
 
 
+def test_within_the_bound_needs_no_quasi_static_warning():
+    """The bench's headline variant (issue "Performance"): completed, R-curve within 2% of `paper`, and kinetic /
+    strain energy at most the solver's warning threshold while the crack grows."""
+    from bench.run_bench import KINETIC_WARN, within_bound
+    ok = dict(status="completed", rcurve_rel_l2=0.015, max_kinetic_over_strain=0.037)
+    assert within_bound(ok)
+    assert not within_bound(dict(ok, max_kinetic_over_strain=0.078))  # warned (rate 2 on the reduced case)
+    assert within_bound(dict(ok, max_kinetic_over_strain=KINETIC_WARN))
+    assert not within_bound(dict(ok, max_kinetic_over_strain=math.nan))  # never grew: nothing to compare
+    assert not within_bound(dict(ok, rcurve_rel_l2=0.021))
+    assert not within_bound(dict(ok, status="failed"))
+
+
 def start_paper_preset(enamel, tmp_path):
     """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
     terminal's process group); returns once the solver has written its first partial result."""
