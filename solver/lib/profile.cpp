@@ -13,12 +13,19 @@ namespace {
 
 using clock = std::chrono::steady_clock;
 
+constexpr int kRounds = 5;  // interleaved timing rounds per kernel (profileKernels)
+
 // Seconds per call of f, over `steps` calls.
 template <class F>
 double secondsPerCall(long steps, F&& f) {
   const auto t0 = clock::now();
   for (long i = 0; i < steps; ++i) f();
   return std::chrono::duration<double>(clock::now() - t0).count() / std::max(1L, steps);
+}
+
+double median(std::vector<double> x) {
+  std::sort(x.begin(), x.end());
+  return x[x.size() / 2];
 }
 
 // a[i] = b[i] + s c[i] (STREAM's triad, 24 bytes per element) over vectors of at least 2^23 doubles (64 MB
@@ -90,18 +97,34 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
   State& s = sim.state;
   VecX f;
   std::vector<double> ratio;
-  long computed = 0;  // rod elements the scheduled deletion check computed over the timed steps
-  const double step = secondsPerCall(steps, [&] {
+  // Each kernel timed in kRounds interleaved rounds of steps / kRounds calls, the median round kept: all of
+  // them see the machine in the same minutes (this machine's speed varies by up to 2x within an afternoon),
+  // and "step - advance" is a difference of neighbours. A round of the whole step begins with one untimed step:
+  // the kernels timed alone in between advance the clock, so the stress check's schedule starts afresh there
+  // (every element computed once) and not in the timed calls.
+  const long perRound = std::max(1L, steps / kRounds);
+  std::vector<double> stepT, advanceT, interfacesT, checkT, positionsT;
+  long computed = 0, timedSteps = 0;  // rod elements the scheduled deletion check computed over the timed steps
+  for (int round = 0; round < kRounds; ++round) {
     sim.step();
-    computed += sim.stressCheckSchedule().computed;
-  });
-  p.stressComputedFraction = static_cast<double>(computed) / std::max(1.0, static_cast<double>(steps) * m.numBeams());
-  const double advance = secondsPerCall(steps, [&] { sim.integrator->advance(m, sim.materials, sim.ops, s); });
-  const double interfaces = secondsPerCall(
-      steps, [&] { computeForcesForInterfaces(m, sim.materials.law, sim.ops, s.q, s.lambdaMax, false, f); });
-  const double check = secondsPerCall(
-      steps, [&] { computeStressRatiosForBeams(m, sim.materials, s.q, s.beamBroken, ratio); });
-  const double positions = secondsPerCall(steps, [&] { advancePositions(s.q, s.vHalf, sim.integrator->timeStep()); });
+    stepT.push_back(secondsPerCall(perRound, [&] {
+      sim.step();
+      computed += sim.stressCheckSchedule().computed;
+      ++timedSteps;
+    }));
+    advanceT.push_back(secondsPerCall(perRound, [&] { sim.integrator->advance(m, sim.materials, sim.ops, s); }));
+    interfacesT.push_back(secondsPerCall(
+        perRound, [&] { computeForcesForInterfaces(m, sim.materials.law, sim.ops, s.q, s.lambdaMax, false, f); }));
+    checkT.push_back(secondsPerCall(
+        perRound, [&] { computeStressRatiosForBeams(m, sim.materials, s.q, s.beamBroken, ratio); }));
+    positionsT.push_back(
+        secondsPerCall(perRound, [&] { advancePositions(s.q, s.vHalf, sim.integrator->timeStep()); }));
+  }
+  p.steps = perRound * kRounds;
+  p.stressComputedFraction =
+      static_cast<double>(computed) / std::max(1.0, static_cast<double>(timedSteps) * m.numBeams());
+  const double step = median(stepT), advance = median(advanceT), interfaces = median(interfacesT),
+               check = median(checkT), positions = median(positionsT);
   p.triadBytesPerSecond = measureTriad(3 * static_cast<long>(p.dof));
   p.kernels = {
       {"step", "the whole time step (integrator's advance, rod stress check, crack measure when something failed)",
@@ -127,9 +150,9 @@ std::string formatProfileMarkdown(const KernelProfile& p) {
   char buf[512];
   const double step = p.kernels.empty() ? 0 : p.kernels.front().secondsPerStep;
   std::snprintf(buf, sizeof buf,
-                "%.0f DOF, %d thread(s), %ld steps per kernel: %.4g s/step, %.1f M DOF-updates/s per core; "
+                "%.0f DOF, %d thread(s), %ld steps per kernel in %d interleaved rounds (median round): %.4g s/step, %.1f M DOF-updates/s per core; "
                 "triad %.1f GB/s\n\n",
-                p.dof, p.threads, p.steps, step, p.dof / step / p.threads / 1e6, p.triadBytesPerSecond / 1e9);
+                p.dof, p.threads, p.steps, kRounds, step, p.dof / step / p.threads / 1e6, p.triadBytesPerSecond / 1e9);
   o << buf;
   o << "| kernel | s/step | share of step | MB/step | GB/s | % of triad | what |\n|---|---|---|---|---|---|---|\n";
   for (const KernelTiming& k : p.kernels) {

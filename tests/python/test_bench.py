@@ -60,6 +60,26 @@ def test_within_the_bound_needs_no_quasi_static_warning():
     assert not within_bound(dict(ok, status="failed"))
 
 
+def test_profile_times_every_kernel_and_refuses_the_paper_scheme(enamel):
+    """`enamel-dem profile` (what `make bench` writes into bench/profile.md): one table row per kernel with a
+    positive time, the step's parts no larger than the step, in interleaved rounds; the `paper` scheme is refused
+    as bad input. Correctness of the report only: no speed is asserted."""
+    case = str(ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml")
+    args = [str(enamel), "profile", case, "--preset", "ci", "--set", "w_s_over_d=8", "--set", "h_s_over_d=4",
+            "--set", "threads=1", "--steps", "10"]
+    r = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "10 steps per kernel in 5 interleaved rounds (median round)" in r.stdout
+    rows = {line.split("|")[1].strip(): float(line.split("|")[2]) for line in r.stdout.splitlines()
+            if line.startswith("| ") and not line.startswith("| kernel")}
+    assert set(rows) == {"step", "advance", "interfaces", "nodes", "positions", "check and rest",
+                         "(stress check, every element)"}
+    assert all(t >= 0 for t in rows.values()) and rows["step"] > 0 and rows["interfaces"] > 0
+    assert rows["nodes"] + rows["interfaces"] + rows["positions"] >= rows["advance"] * (1 - 1e-3)  # printed to 4 digits
+    r = subprocess.run(args + ["--set", 'integrator="paper"'], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 7 and "integrator 'paper' is not profiled (allowed: lumped)" in r.stderr
+
+
 def start_paper_preset(enamel, tmp_path):
     """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
     terminal's process group); returns once the solver has written its first partial result."""
