@@ -1,6 +1,7 @@
 """Numbers computed from loaded results: R-curve differences (bench, reference tests) and Fig. 9's pooled R_m."""
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -21,3 +22,92 @@ def pooled_rm(results: list, lo: float = 0.0, hi: float = 30.0) -> tuple[float, 
     if pts.size == 0:
         return math.nan, math.nan, 0
     return float(pts.mean()), float(pts.std()), int(pts.size)
+
+
+# --- "The same R-curve" (docs: the measure of studies/square/README.md) --------------------------------------
+# Two sawtooth R-curves are compared by their level over the crack advance, not pointwise: the pointwise L2 is
+# dominated by where the teeth fall. One definition, used by the studies, the bench and the tests.
+
+RANGE_OVER_D = (0.0, 30.0)      # the advance over which R is averaged
+MIN_RANGE_OVER_D = 10.0         # shorter common ranges are "not comparable"
+WINDOWS_OVER_D = ((0.0, 10.0), (10.0, 20.0), (20.0, 30.0))   # reported beside the decision, never deciding
+ROD_REL_TOL, ROD_ABS_TOL = 0.2, 2   # broken rod elements over the range: within 20%, or within 2 elements
+TOL_MESH_SIZE, TOL_RATE_SPEED = 0.10, 0.02
+TOTAL_COUNTS_WITHIN_OVER_D = 1.0   # a record's total broken rods counts up to hi when its curve ends this close past hi
+
+
+@dataclasses.dataclass(frozen=True)
+class RCurve:
+    """An R-curve: R/Gamma_i at crack advance da (Delta_a/d, non-decreasing), and the crack advance at which each
+    rod element broke (rod_da; None when only the total `broken_rods` up to da[-1] is known)."""
+    da: np.ndarray
+    R: np.ndarray
+    rod_da: np.ndarray | None = None
+    broken_rods: int | None = None
+
+    @staticmethod
+    def of(da, R, rod_da=None, broken_rods=None) -> "RCurve":
+        da, R = np.asarray(da, dtype=float), np.asarray(R, dtype=float)
+        if da.ndim != 1 or da.shape != R.shape or da.size < 2 or np.any(np.diff(da) < 0):
+            raise ValueError("an R-curve needs >= 2 points with Delta_a non-decreasing")
+        return RCurve(da, R, None if rod_da is None else np.asarray(rod_da, dtype=float), broken_rods)
+
+    def rods_up_to(self, hi: float) -> int | None:
+        """Rod elements broken by crack advance hi. When only the total is known, it stands for the count up to hi
+        if the curve ends within TOTAL_COUNTS_WITHIN_OVER_D past hi (the runs that stop at 30 d end at 30.1-30.6 d);
+        otherwise None (unknown)."""
+        if self.rod_da is not None:
+            return int(np.count_nonzero(self.rod_da <= hi))
+        return self.broken_rods if self.da[-1] - hi <= TOTAL_COUNTS_WITHIN_OVER_D else None
+
+
+def advance_mean(c: RCurve, lo: float, hi: float) -> float:
+    """R averaged over crack advance over (lo, hi]: the integral of the piecewise-linear R(Delta_a) over the part
+    of (lo, hi] the curve covers, divided by that length (nan when it covers none)."""
+    a, b = max(lo, float(c.da[0])), min(hi, float(c.da[-1]))
+    if not b > a:
+        return math.nan
+    inside = (c.da > a) & (c.da < b)
+    x = np.concatenate(([a], c.da[inside], [b]))
+    y = np.concatenate(([_interp(c, a)], c.R[inside], [_interp(c, b)]))
+    return float(np.trapz(y, x) / (b - a))
+
+
+def _interp(c: RCurve, x: float) -> float:
+    return float(np.interp(x, c.da, c.R))
+
+
+@dataclasses.dataclass(frozen=True)
+class Comparison:
+    """Curve b against reference a by the measure; `same` decides, the windows and `l2` are reported only."""
+    tol: float
+    hi: float               # the common range is (lo, hi]
+    comparable: bool        # hi - lo >= MIN_RANGE_OVER_D
+    mean_a: float
+    mean_b: float
+    mean_rel: float         # (mean_b - mean_a) / mean_a
+    init_rel: float         # (R_init_b - R_init_a) / R_init_a
+    rods_a: int | None      # broken rod elements over the common range
+    rods_b: int | None
+    rods_ok: bool
+    windows: tuple          # ((lo, hi, mean_a, mean_b), ...) of WINDOWS_OVER_D within the common range
+    l2: float               # pointwise relative L2 over the common range
+    same: bool
+
+
+def same_rcurve(a: RCurve, b: RCurve, tol: float, lo: float = RANGE_OVER_D[0],
+                hi: float = RANGE_OVER_D[1]) -> Comparison:
+    """"The same R-curve": over the common range of (lo, hi] (at least MIN_RANGE_OVER_D), R averaged over crack
+    advance and R_init (the first point) within `tol` (relative to a), and the broken rod elements over the range
+    within ROD_REL_TOL (or ROD_ABS_TOL elements)."""
+    top = min(hi, float(a.da[-1]), float(b.da[-1]))
+    comparable = top - lo >= MIN_RANGE_OVER_D - 1e-9
+    ma, mb = advance_mean(a, lo, top), advance_mean(b, lo, top)
+    mean_rel, init_rel = (mb - ma) / ma, (float(b.R[0]) - float(a.R[0])) / float(a.R[0])
+    ra, rb = a.rods_up_to(top), b.rods_up_to(top)
+    rods_ok = ra is not None and rb is not None and abs(ra - rb) <= max(ROD_REL_TOL * max(ra, rb), ROD_ABS_TOL)
+    windows = tuple((w0, w1, advance_mean(a, w0, w1), advance_mean(b, w0, w1))
+                    for w0, w1 in WINDOWS_OVER_D if w1 <= top + 1e-9)
+    l2 = rcurve_rel_l2(a.da, a.R, b.da, b.R)
+    same = bool(comparable and abs(mean_rel) <= tol and abs(init_rel) <= tol and rods_ok)
+    return Comparison(tol, top, comparable, ma, mb, mean_rel, init_rel, ra, rb, rods_ok, windows, l2, same)

@@ -1,0 +1,271 @@
+"""The interface-ductility identification on square specimens (README.md here: the plan, the measure and the rule,
+committed before the runs).
+
+    python3 -m studies.square.square run S G [--he H] [--rate F]   # one run (one thread) and its record
+    python3 -m studies.square.square record RUN_DIR                # the record of a finished run
+    python3 -m studies.square.square report                        # README's Results and rcurves.png from the records
+
+A run's folder is runs/square/<name>/ (not kept); its record is data/<name>.json (kept): metrics, status, steps,
+wall time, the R-curve to 10 digits and the crack advance of every rod break, so the report regenerates without
+the runs.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import pathlib
+import platform
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+from enamel_results import metrics, paths, results
+
+HERE = pathlib.Path(__file__).resolve().parent
+DATA = HERE / "data"
+RUNS = paths.RUNS / "square"
+CASE = "theta30_s21.4_e10_cv0"
+PAPER_LEVEL = 7.0            # the paper's R/Gamma_i "at Delta_a ~ 15 d" for this case (the rule's target)
+SELECT_WINDOW = (5.0, 25.0)  # the rule's mean
+NUMERICS = {"integrator": '"lumped"', "dt_factor": "0.22", "damping_cap": "0.5", "static_start": "0.95"}
+CURVE_DIGITS = 10
+
+
+def run_name(size: float, G: float, he: float = 0.3, rate: float = 1.0, extra: str = "") -> str:
+    name = f"s{size:g}_he{he:g}_G{G:g}" + (f"_rate{rate:g}" if rate != 1.0 else "")
+    return name + (f"_{extra}" if extra else "")
+
+
+def solver_args(binary, size, G, he, rate, out, sets=()) -> list[str]:
+    over = {"w_s_over_d": f"{size:g}", "h_s_over_d": f"{size:g}", "Gamma_k_over_sigma0sq": f"{G:g}",
+            "h_e_over_d": f"{he:g}", "rate_factor": f"{rate:g}", **NUMERICS, "threads": "1",
+            "checkpoint_interval_s": "600"}
+    over.update(dict(s.split("=", 1) for s in sets))
+    args = [str(binary), "run", str(paths.case_file(CASE)), "--preset", "paper", "--resume", "-o", str(out)]
+    for k, v in over.items():
+        args += ["--set", f"{k}={v}"]
+    return args
+
+
+def first_existing(run_dir: pathlib.Path) -> pathlib.Path:
+    for name in ("result.h5", "result.partial.h5", "result.failed.h5"):
+        if (run_dir / name).exists():
+            return run_dir / name
+    raise results.MissingResult(run_dir / "result.h5")
+
+
+def rod_breaks(result_h5: pathlib.Path) -> list[float]:
+    """Crack advance at each rod element's deletion, from /history (one entry per element)."""
+    with h5py.File(result_h5, "r") as f:
+        h = f["history"]
+        da, broken = np.asarray(h["da_over_d"]), np.asarray(h["broken_rod_elements"]).astype(int)
+    out, prev = [], 0
+    for d, b in zip(da, broken):
+        out += [float(d)] * max(b - prev, 0)
+        prev = max(prev, b)
+    return out
+
+
+def record_of(run_dir: pathlib.Path, name: str) -> dict:
+    path = first_existing(run_dir)
+    r = results.load_result(path)
+    m = r.meta
+    keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt", "git_hash",
+            "max_kinetic_over_strain_while_growing", "peak_memory_mb", "warnings")
+    meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
+    meta = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in meta.items()}
+    with h5py.File(path, "r") as f:
+        meta["balance_end"] = float(f["history/energy_balance_error"][-1])
+    params = {k: r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "Gamma_k_over_sigma0sq",
+                                      "rate_factor")}
+    return dict(name=name, case=r.case, machine=platform.processor() or platform.machine(), cpu=_cpu(),
+                meta=meta, params=params, R_init=r.R_init, da_max=r.da_max, broken_rods=r.broken_rods,
+                rod_da=[float(f"{x:.6g}") for x in rod_breaks(path)],
+                da=[float(f"{x:.{CURVE_DIGITS}g}") for x in r.da], R=[float(f"{x:.{CURVE_DIGITS}g}") for x in r.R])
+
+
+def _cpu() -> str:
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.machine()
+
+
+def store(rec: dict, data: pathlib.Path = DATA) -> pathlib.Path:
+    data.mkdir(parents=True, exist_ok=True)
+    out = data / f"{rec['name']}.json"
+    out.write_text(json.dumps(rec, indent=1) + "\n")
+    return out
+
+
+def load_records(data: pathlib.Path = DATA) -> dict[str, dict]:
+    return {p.stem: json.loads(p.read_text()) for p in sorted(data.glob("*.json"))}
+
+
+def curve(rec: dict) -> metrics.RCurve:
+    return metrics.RCurve.of(rec["da"], rec["R"], rec.get("rod_da"), rec.get("broken_rods"))
+
+
+def level(rec: dict, lo: float, hi: float) -> float:
+    return metrics.advance_mean(curve(rec), lo, hi)
+
+
+# ------------------------------------------------------------------------------------------------ the report
+def fmt(v, spec=".3g") -> str:
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def pct(v) -> str:
+    return "-" if v is None or math.isnan(v) else f"{100 * v:+.1f}%"
+
+
+def first_break(rec: dict) -> float:
+    return rec["rod_da"][0] if rec.get("rod_da") else math.nan
+
+
+def run_rows(recs: dict) -> list[str]:
+    lines = ["| run | status | steps | wall min | Delta_a max | R_init | R (0,30] | (0,10] | (10,20] | (20,30] | "
+             "**(5,25]** | broken rods | first break at | KE/SE max | balance | machine |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, rec in recs.items():
+        m = rec["meta"]
+        lines.append(f"| {name} | {m.get('status')} | {m.get('steps')} | {fmt(m.get('wall_time_s', math.nan) / 60, '.0f')} | "
+                     f"{rec['da_max']:.1f} | {rec['R_init']:.3f} | {fmt(level(rec, 0, 30))} | "
+                     + " | ".join(fmt(level(rec, a, b)) for a, b in metrics.WINDOWS_OVER_D)
+                     + f" | **{fmt(level(rec, *SELECT_WINDOW))}** | {rec['broken_rods']} | {fmt(first_break(rec), '.2f')} | "
+                     f"{fmt(m.get('max_kinetic_over_strain_while_growing'), '.3f')} | {fmt(m.get('balance_end'), '.1e')} | "
+                     f"{rec.get('cpu', '')} |")
+    return lines
+
+
+def compare_line(what: str, ref: str, other: str, recs: dict, tol: float) -> tuple[str, bool]:
+    c = metrics.same_rcurve(curve(recs[ref]), curve(recs[other]), tol)
+    verdict = "**same**" if c.same else ("not comparable" if not c.comparable else "**differ**")
+    wins = ", ".join(f"{pct((wb - wa) / wa)}" for _, _, wa, wb in c.windows)
+    return (f"| {what} | {ref} | {other} | {tol:.0%} | (0,{c.hi:.1f}] | {pct(c.mean_rel)} | {pct(c.init_rel)} | "
+            f"{c.rods_a} / {c.rods_b} | {wins} | {100 * c.l2:.1f}% | {verdict} |", c.same)
+
+
+PAIR_HEAD = ["| check | reference | other | tolerance | range | R mean | R_init | broken rods | windows | L2 (reported) | verdict |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+
+
+def pairs(recs: dict) -> list[tuple[str, str, str, float, float]]:
+    """(check, reference, other, tolerance, G) for every pair the records allow: size (the two largest square sizes
+    at h_e 0.3 and the preset's rate), mesh (h_e 0.3 / 0.15 at one size), rate (half-rate twin)."""
+    out, by = [], {}
+    for name, rec in recs.items():
+        p = rec["params"]
+        by[(p["w_s_over_d"], p["h_e_over_d"], p["Gamma_k_over_sigma0sq"], p["rate_factor"], name)] = name
+    Gs = sorted({k[2] for k in by})
+    for G in Gs:
+        plain = sorted((k[0], n) for k, n in by.items() if k[2] == G and k[1] == 0.3 and k[3] == 1.0
+                       and n == run_name(k[0], G))
+        if len(plain) >= 2:
+            out.append(("size", plain[-2][1], plain[-1][1], metrics.TOL_MESH_SIZE, G))
+        for k, n in by.items():
+            if k[2] == G and k[1] != 0.3 and n == run_name(k[0], G, he=k[1]) and run_name(k[0], G) in recs:
+                out.append(("mesh", run_name(k[0], G), n, metrics.TOL_MESH_SIZE, G))
+            if k[2] == G and k[3] != 1.0 and run_name(k[0], G) in recs and n == run_name(k[0], G, rate=k[3]):
+                out.append((f"rate x{k[3]:g}", run_name(k[0], G), n, metrics.TOL_RATE_SPEED, G))
+    return out
+
+
+def selection(recs: dict, checks: list) -> list[str]:
+    """The rule: converged (size, mesh and a rate twin, each the same) and nearest PAPER_LEVEL by the (5,25] mean of
+    the size pair, rods breaking."""
+    lines = ["| G | size | mesh | rate twin | (5,25] mean of the size pair | rods break | converged |", "|---|---|---|---|---|---|---|"]
+    best = None
+    for G in sorted({c[4] for c in checks} | {r["params"]["Gamma_k_over_sigma0sq"] for r in recs.values()}):
+        mine = [c for c in checks if c[4] == G]
+        verdicts = [(c[0], compare_line(*c[:3], recs, c[3])[1]) for c in mine]
+        got = {kind: [ok for k, ok in verdicts if k.startswith(kind)] for kind in ("size", "mesh", "rate")}
+        size_pair = [c for c in mine if c[0] == "size"]
+        level_G = (np.mean([level(recs[n], *SELECT_WINDOW) for n in size_pair[0][1:3]]) if size_pair else math.nan)
+        rods = bool(size_pair) and all(recs[n]["broken_rods"] > 0 for n in size_pair[0][1:3])
+        status = {k: ("-" if not v else ("yes" if all(v) else "no")) for k, v in got.items()}
+        conv = all(status[k] == "yes" for k in ("size", "mesh", "rate"))
+        lines.append(f"| {G:g} | {status['size']} | {status['mesh']} | {status['rate']} | {fmt(level_G)} | "
+                     f"{'yes' if rods else '-'} | {'**yes**' if conv else 'no'} |")
+        if conv and rods and (best is None or abs(level_G - PAPER_LEVEL) < abs(best[1] - PAPER_LEVEL)):
+            best = (G, level_G)
+    lines += ["", f"**Selected: G = {best[0]:g}** ((5,25] mean {best[1]:.2f} against the paper's ~{PAPER_LEVEL:g})."
+              if best else "**Selected: none yet** (no G is converged in size, mesh and rate by the records so far)."]
+    return lines
+
+
+def figure(recs: dict, out: pathlib.Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for name, rec in recs.items():
+        ls = "-" if rec["params"]["w_s_over_d"] >= 100 else "--"
+        ax.plot(rec["da"], rec["R"], ls, lw=1, label=name)
+    ax.axhline(PAPER_LEVEL, color="k", lw=0.8, ls=":", label=f"paper ~{PAPER_LEVEL:g}")
+    ax.set_xlabel(r"$\Delta a / d$")
+    ax.set_ylabel(r"$R / \Gamma_i$")
+    ax.set_title("theta30 (21.4, 10), square specimens (records of studies/square)")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def report(data: pathlib.Path = DATA, readme: pathlib.Path = HERE / "README.md") -> str:
+    recs = load_records(data)
+    checks = pairs(recs)
+    lines = ["", "Generated by `python3 -m studies.square.square report` from `data/*.json`. R is R/Gamma_i averaged over",
+             "crack advance in each window (d); the (5,25] mean decides the selection.", "", "### Runs", ""]
+    lines += run_rows(recs) + ["", "### Convergence checks (the measure; L2 and windows reported only)", ""]
+    lines += PAIR_HEAD + [compare_line(*c[:3], recs, c[3])[0] for c in checks]
+    lines += ["", "### Selection", ""] + selection(recs, checks) + [""]
+    if recs:
+        figure(recs, HERE / "rcurves.png")
+        lines += ["![R-curves](rcurves.png)", ""]
+    text = readme.read_text()
+    head = text.split("\n## Results\n", 1)[0]
+    readme.write_text(head + "\n## Results\n" + "\n".join(lines))
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------------------------- main
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run", help="run one case (one thread) and record it")
+    r.add_argument("size", type=float, help="w_s = h_s, in d")
+    r.add_argument("G", type=float, help="Gamma_k_over_sigma0sq")
+    r.add_argument("--he", type=float, default=0.3, help="h_e_over_d (default 0.3)")
+    r.add_argument("--rate", type=float, default=1.0, help="rate_factor (default 1)")
+    r.add_argument("--set", action="append", default=[], help="further key=value for the solver (named in the run)")
+    r.add_argument("--name", default="", help="suffix of the run's name (required with --set)")
+    r.add_argument("--binary", default=str(paths.SOLVER))
+    rec = sub.add_parser("record", help="record a finished run")
+    rec.add_argument("run_dir", type=pathlib.Path)
+    sub.add_parser("report", help="README Results and rcurves.png from the records")
+    a = ap.parse_args(argv)
+    if a.cmd == "run":
+        if a.set and not a.name:
+            ap.error("--set needs --name (the run's name must say what differs)")
+        name = run_name(a.size, a.G, a.he, a.rate, a.name)
+        out = RUNS / name
+        out.mkdir(parents=True, exist_ok=True)
+        rc = subprocess.call(solver_args(a.binary, a.size, a.G, a.he, a.rate, out, a.set))
+        print(f"square: solver exit {rc}; recorded {store(record_of(out, name))}")
+        return rc
+    if a.cmd == "record":
+        print(store(record_of(a.run_dir, a.run_dir.name)))
+        return 0
+    print(report())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
