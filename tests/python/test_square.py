@@ -1,0 +1,61 @@
+"""The square study's report (studies/square/square.py) from records alone: the runs table, the checks by the
+measure, and the selection rule (converged in size, mesh and rate; nearest 7 by the (5,25] mean, rods breaking)."""
+import json
+
+import numpy as np
+
+from studies.square import square
+
+DA = np.arange(0.15, 30.16, 0.3)
+
+
+def record(name, size, G, level, he=0.3, rate=1.0, rods=(2, 4, 6, 8)):
+    R = level + 0.5 * np.sin(DA)
+    R[0] = 5.0
+    return dict(name=name, case=square.CASE, cpu="test", meta=dict(status="completed", steps=1, wall_time_s=60.0),
+                params=dict(w_s_over_d=size, h_s_over_d=size, h_e_over_d=he, Gamma_k_over_sigma0sq=G,
+                            rate_factor=rate),
+                R_init=5.0, da_max=float(DA[-1]), broken_rods=len(rods), rod_da=list(rods),
+                da=DA.tolist(), R=R.tolist())
+
+
+def write(tmp_path, recs):
+    data = tmp_path / "data"
+    data.mkdir()
+    for r in recs:
+        (data / f"{r['name']}.json").write_text(json.dumps(r))
+    readme = tmp_path / "README.md"
+    readme.write_text("# plan\n\nthe rule\n\n## Results\nold text\n")
+    return data, readme
+
+
+def test_the_rule_selects_the_converged_G_nearest_7(tmp_path):
+    n = square.run_name
+    recs = [record(n(80, 8), 80, 8, 8.0), record(n(100, 8), 100, 8, 7.9),          # size only: not converged
+            record(n(80, 10), 80, 10, 6.6), record(n(100, 10), 100, 10, 6.8),
+            record(n(40, 10), 40, 10, 6.5), record(n(40, 10, he=0.15), 40, 10, 6.9, he=0.15),
+            record(n(80, 10, rate=0.5), 80, 10, 6.65, rate=0.5),
+            record(n(80, 12), 80, 12, 5.0), record(n(100, 12), 100, 12, 6.0)]     # size differs by 20%
+    data, readme = write(tmp_path, recs)
+    text = square.report(data, readme)
+    out = readme.read_text()
+    assert out.startswith("# plan\n\nthe rule\n\n## Results\n") and "old text" not in out   # the plan is kept
+    assert "**Selected: G = 10**" in text
+    assert "| 8 | yes | - | - |" in text and "| 12 | no | - | - |" in text
+    assert "| 10 | yes | yes | yes |" in text
+    assert (tmp_path / "rcurves.png").stat().st_size > 1000
+
+
+def test_nothing_is_selected_without_a_converged_G(tmp_path):
+    n = square.run_name
+    data, readme = write(tmp_path, [record(n(80, 8), 80, 8, 8.0), record(n(100, 8), 100, 8, 7.9)])
+    assert "**Selected: none yet**" in square.report(data, readme)
+
+
+def test_run_arguments_are_the_plans():
+    args = square.solver_args("enamel-dem", 100, 10, 0.3, 1.0, "out")
+    sets = {args[i + 1].split("=")[0]: args[i + 1].split("=", 1)[1] for i, a in enumerate(args) if a == "--set"}
+    assert args[3:5] == ["--preset", "paper"] and "--resume" in args
+    assert sets["w_s_over_d"] == sets["h_s_over_d"] == "100" and sets["Gamma_k_over_sigma0sq"] == "10"
+    assert sets["integrator"] == '"lumped"' and sets["dt_factor"] == "0.22" and sets["damping_cap"] == "0.5"
+    assert sets["static_start"] == "0.95" and sets["threads"] == "1" and sets["rate_factor"] == "1"
