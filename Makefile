@@ -21,6 +21,8 @@
 #
 #   make bench          speed against error of every integrator and knob, and cost growth, in one run (~1.5 h on
 #                       2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
+#                       bench/step_instructions.md
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
 #                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
 #                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
@@ -43,7 +45,7 @@ RUN_SET ?=
 DEB_PACKAGES := g++ make cmake pkg-config git \
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libhdf5-dev libtomlplusplus-dev libcli11-dev libgtest-dev \
   python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest python3-vtk9 \
-  slurm-wlm munge
+  slurm-wlm munge valgrind
 
 # An interpreter that can import the pipeline's modules. The `python3` first on PATH may be a
 # pyenv one without them, so probe the Debian interpreter first; fall back to it (after
@@ -75,7 +77,7 @@ endif
 FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
-.PHONY: bench bench-paper bench-far-field identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
+.PHONY: bench bench-step bench-paper bench-far-field identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
   vtk reference clean-runs check-preset slurm
 
 help:
@@ -119,6 +121,11 @@ bench: $(ENAMEL)
 # runs/identify/, report in studies/identify/. IDENTIFY_ARGS: e.g. --stages ab --stop-starting 02:15.
 identify: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m studies.identify.identify $(IDENTIFY_ARGS)
+
+# Instructions and cache misses per kernel, per interface and per node (valgrind callgrind; independent of how
+# busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.
+bench-step: $(ENAMEL)
+	$(PYTHON) -m bench.step_instructions --binary $(ENAMEL) $(if $(BENCH_STEP_AGAINST),--against $(BENCH_STEP_AGAINST))
 
 bench-paper: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)

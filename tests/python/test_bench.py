@@ -155,3 +155,17 @@ def test_check_100_report_regenerates_from_its_records(tmp_path):
     r = run()
     assert r.returncode == 0, r.stderr
     assert "(bound 0.02: OUTSIDE)" in r.stdout
+
+
+def test_bench_step_reads_callgrind_annotate_columns():
+    """`make bench-step` reads callgrind_annotate's event columns, '.' and a bare 0 being zeros."""
+    from bench.step_instructions import _counts, per_item
+    line = ("   28,224,987 ( 1.60%)    201,687 ( 0.64%)     35,680 ( 0.24%)  .                  0           "
+            "< ???:enamel::profileKernels(enamel::Simulation&, long, long) (10x) [/x/enamel-dem]")
+    assert _counts(line) == [28224987, 201687, 35680, 0, 0]
+    star = line.replace("< ???", "*  ???")
+    assert _counts(star) == [28224987, 201687, 35680, 0, 0]
+    ev = lambda ir: dict(Ir=ir, D1mr=0, D1mw=0, DLmr=0, DLmw=0)  # noqa: E731
+    got = {"step": ev(1100), "advance": ev(1000), "interfaces": ev(600), "positions": ev(100)}
+    items = per_item(got, {"DOF": 10, "nodes": 2, "interfaces": 3})
+    assert items["node rows per node"]["Ir"] == 150 and items["interfaces per interface"]["Ir"] == 200
