@@ -72,7 +72,7 @@ VARIANTS = {
     "lumped cap0.5 dt0.22 rate1.5": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=1.5), 1),
     "lumped cap0.5 dt0.22 rate2": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=2), 1),
     "lumped cap0.5 dt0.22 rate4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=4), 1),
-    # fewer steps (issue "Performance"): the static elastic start, the adaptive loading rate, both
+    # fewer steps: the static elastic start, the adaptive loading rate, both
     "lumped cap0.5 dt0.22 static": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95), 1),
     "lumped cap0.5 dt0.22 adapt4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_adapt_max=4), 1),
     "lumped cap0.5 dt0.22 static adapt4": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95,
@@ -302,7 +302,7 @@ KINETIC_WARN = 0.05  # the solver's quasi-static warning threshold (runner.cpp k
 
 
 def within_bound(row) -> bool:
-    """Completed, R-curve within ERROR_BOUND of the reference, and no quasi-static warning (issue "Performance")."""
+    """Completed, R-curve within ERROR_BOUND of the reference, and no quasi-static warning."""
     return (row.get("status") == "completed" and row.get("rcurve_rel_l2", math.inf) <= ERROR_BOUND
             and row.get("max_kinetic_over_strain", math.inf) <= KINETIC_WARN)
 

@@ -21,7 +21,7 @@ Vec3 Model::rodDirection(int ply) const {
   return Vec3(std::cos(theta), sign * std::sin(theta), 0.0);
 }
 
-// Rod centre lines (DESIGN section 2), with the origin of x put on a crisscross point of the mid-plane:
+// Rod centre lines (docs/model.md), with the origin of x put on a crisscross point of the mid-plane:
 //   ply 1:  y = yCrack + j s + (x - xCrisscross) tan(theta)
 //   ply 2:  y = yCrack + j s - (x - xCrisscross) tan(theta)
 // so that rod 0 of both plies crosses the mid-plane at xCrisscross. At theta = 0 there is no crisscross:

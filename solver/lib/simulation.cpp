@@ -175,7 +175,7 @@ Simulation::Simulation(const CaseParams& p)
   mat.rodStress = beam::parseRodStress(p.rod_stress);
   const beam::Section& section = mat.section;
 
-  // Rod-element strengths: one per element, normal(mean, cv), seeded (DESIGN section 3).
+  // Rod-element strengths: one per element, normal(mean, cv), seeded (docs/model.md).
   // Strengths drawn rod by rod, along each rod from its first slice (the realisation of a seed does not
   // depend on how the model numbers its rod elements). An element of the reduced far field spanning n
   // slices takes the n draws of the full model's elements it stands for, and the weakest of them.
@@ -233,7 +233,7 @@ Simulation::Simulation(const CaseParams& p)
   ops.M = assembleBeams(m, mat.beamMc, n, cutMass);
   mat.omegaMaxElement = beam::maxFrequency(section, m.beamLength, beam::MassKind::Consistent);
 
-  // Wave speed and Rayleigh damping (paper eq. 1-3, DESIGN section 4): C = a M + b K,
+  // Wave speed and Rayleigh damping (paper eq. 1-3, docs/solver.md): C = a M + b K,
   // a = zeta w_min, b = zeta / w_min, w_min = pi c_d / h_s.
   mat.E_transverse = p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p);
   mat.c_d = std::sqrt(mat.E_transverse / 1.0);
@@ -416,7 +416,7 @@ void Simulation::step() {
 
 namespace {
 
-// Deletion rule (DESIGN section 3), independent of element order and thread count:
+// Deletion rule (docs/model.md), independent of element order and thread count:
 //  "most_overloaded": the element(s) with the largest stress ratio >= 1, ties within 1e-9 relative
 //                     (mirror-symmetric rods) together; the rest are re-evaluated next step.
 //  "all":             every element with ratio >= 1.
@@ -446,7 +446,7 @@ void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool c
 
 // A deleted element's stiffness (and its stiffness damping) is removed; its consistent mass is replaced by
 // the lumped mass of the same element, so no material mass vanishes and no node is left massless (the paper
-// subtracts M_e, eq. 17; see README "Model"). The energy it held is booked as rod fracture energy.
+// subtracts M_e, eq. 17; see docs/model.md, departures). The energy it held is booked as rod fracture energy.
 int Simulation::deleteOverloadedBeams() {
   lastDeleted.clear();
   if (!materials.rodsBreakable) return 0;
@@ -531,7 +531,7 @@ int Simulation::countInelasticInterfaces() const {
   return n;
 }
 
-// J at the outer boundary (DESIGN section 5), per unit thickness B:
+// J at the outer boundary (docs/model.md), per unit thickness B:
 //   J = (1/B) [ - sum_{loaded nodes} F_y (du_y/dx)  +  W_right - W_left ]
 // with F_y the force the grips apply, du_y/dx = -/+ U / w_s on the top/bottom rows, and W the strain energy
 // per unit length in x at the free left and right faces (first slice: beams of the first segment over h_e,
@@ -567,7 +567,7 @@ double Simulation::computeJ() const {
   return (-sumFdudx + Wright - Wleft) / m.B;
 }
 
-// Crack tip (DESIGN section 5): the connected cluster of failed interfaces and deleted rod elements that
+// Crack tip (docs/model.md): the connected cluster of failed interfaces and deleted rod elements that
 // touches the pre-crack. Each element touches (rod, slice) points (an interface: its two rods in its slice;
 // a rod element: its rod at its two slices); two elements are connected when they touch the same rod in the
 // same or adjacent slices. Delta_a = max x over the cluster - a0 (projected on x); daughter cracks do not count.

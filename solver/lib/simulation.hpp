@@ -1,7 +1,7 @@
 #pragma once
 // The simulation: the plain data of a run (state.hpp) and its integrator, the level above a scheme's step
 // (rod deletions, crack tracking), and the measurements (J at the outer boundary, crack advance, energy
-// balance). DESIGN.md sections 3-5.
+// balance). docs/model.md.
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -88,7 +88,7 @@ class Simulation {
 
   // --- measurements ---
   Measurement measure() const;
-  double computeJ() const;                 // J at the outer boundary (DESIGN section 5)
+  double computeJ() const;                 // J at the outer boundary (docs/model.md)
   double measureCrackAdvance() const;      // Delta a of the cluster of failed elements touching the pre-crack
   double strainEnergyOfBeams() const;      // 1/2 q^T K q
   double strainEnergyOfInterfaces() const;

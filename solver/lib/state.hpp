@@ -1,5 +1,5 @@
 #pragma once
-// The plain data a run is made of (DESIGN.md sections 3-5), in four parts that change at different rates:
+// The plain data a run is made of (docs/model.md), in four parts that change at different rates:
 //   Model      the geometry (geometry.hpp): nodes, rod elements, interfaces; never changes
 //   Materials  what the rods and interfaces are made of, how the specimen is damped and loaded; never changes
 //   Operators  the assembled rod matrices K, M (rod deletions change them), DOF maps, interface adjacency
@@ -22,7 +22,7 @@ namespace enamel {
 using VecX = Eigen::VectorXd;
 using SpMat = Eigen::SparseMatrix<double>;
 
-/// Graded velocity loading on the top and bottom boundary rows (DESIGN section 4):
+/// Graded velocity loading on the top and bottom boundary rows (docs/solver.md):
 ///   u_y = +/- U(t) (1 - x / w_s),  U' = v_app r(t),  r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
 /// With an adaptive rate (rateAdaptMax > 1, loading_rate.hpp) the argument is the loading clock tau, not t.
 struct Loading {

@@ -1,4 +1,4 @@
-"""The reduced far field (issue "Model only what a scene needs"; README "Reduced far field") against the full
+"""The reduced far field (docs/solver.md, "Reduced far field") against the full
 model at 80 x 80 d, theta_D = 30 (21.4, 10), `make bench-paper`'s variant (lumped, dt_factor 0.22, damping_cap
 0.5, static_start 0.95), 1 thread, to Delta_a = 30 d.
 
@@ -137,7 +137,7 @@ def by_case(records: dict) -> dict:
 
 
 def scene_of(run_dir: pathlib.Path) -> dict:
-    """Where the damage is at the run's last frame (issue 16, item 1): the distances from the crack plane of the
+    """Where the damage is at the run's last frame (studies/scene/): the distances from the crack plane of the
     deleted rod elements (sorted) and of the interfaces with damage > 0 (largest, 99th percentile)."""
     import h5py
     with h5py.File(result_file(run_dir), "r") as f:

@@ -1,5 +1,5 @@
 // J at the outer boundary against the compliance and energy release rates of an elastic cracked specimen
-// (issue "Reference solver"): static elastic solutions at three crack lengths, theta_D = 0 and 30.
+// (docs/verification.md): static elastic solutions at three crack lengths, theta_D = 0 and 30.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-"""The bench script itself (issue "Speed against error"), in its --quick mode (tiny specimens at the ci preset):
+"""The bench script itself, in its --quick mode (tiny specimens at the ci preset):
 it runs, writes results.csv, cost_growth.csv, results.md and both figures, measures the reference against
 itself as zero error, and computes the errors of the other variants against it. Correctness only: no
 timing is asserted here (`make bench` measures). Also `make bench-paper`'s script (bench/paper_preset.py):
@@ -48,7 +48,7 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
 
 
 def test_within_the_bound_needs_no_quasi_static_warning():
-    """The bench's headline variant (issue "Performance"): completed, R-curve within 2% of `paper`, and kinetic /
+    """The bench's headline variant: completed, R-curve within 2% of `paper`, and kinetic /
     strain energy at most the solver's warning threshold while the crack grows."""
     from bench.run_bench import KINETIC_WARN, within_bound
     ok = dict(status="completed", rcurve_rel_l2=0.015, max_kinetic_over_strain=0.037)
@@ -81,7 +81,7 @@ def test_profile_times_every_kernel_and_refuses_the_paper_scheme(enamel):
 
 
 def start_paper_preset(enamel, tmp_path):
-    """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
+    """bench/paper_preset.py --quick on a run long enough to interrupt, started in a process group of its own (as a
     terminal's process group); returns once the solver has written its first partial result."""
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
     cmd = [sys.executable, "-m", "bench.paper_preset", "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),

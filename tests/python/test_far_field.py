@@ -1,4 +1,4 @@
-"""The reduced far field (case keys far_field_slices, full_half_height_over_d; README "Reduced far field") through
+"""The reduced far field (case keys far_field_slices, full_half_height_over_d; docs/solver.md, "Reduced far field") through
 the command line: a band wider than the specimen gives the full model's run bit for bit; a run whose inelastic
 zone comes within 2 d of the band's edge stops with a message saying so and keeps what it wrote; a far field
 without its band is refused before anything is written. The elastic response against the full model is the C++

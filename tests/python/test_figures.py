@@ -1,9 +1,9 @@
-"""Figure scripts and summary table (issue "Pipeline and figures"): each script runs on result files and writes
+"""Figure scripts and summary table: each script runs on result files and writes
 a non-empty PDF and PNG, a missing result file is one clear line and a non-zero exit, the summary table has one
 row per case with our HDF5 attributes copied exactly, and each number of paper_values.toml is what its quote says.
 
 The result files come from tiny runs (8 d x 4 d specimen, stopped at Delta_a/d = 1.5, ~2 s each) made once per
-session (conftest.tiny_run) in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/.
+pytest run (conftest.tiny_run) in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/.
 Scripts run in this process (runpy, as `python3 -m figures.<script>` runs them) to keep the tests fast; one
 missing-file test runs a script as a subprocess for the real exit status.
 """

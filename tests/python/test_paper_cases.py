@@ -1,5 +1,5 @@
 """paper_cases/: every case file parses and builds at the ci preset, and figures.toml names only existing cases
-covering the paper's grid (issue "Pipeline and figures", case list)."""
+covering the paper's grid ."""
 import pathlib
 import tomllib
 

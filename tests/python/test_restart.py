@@ -1,4 +1,4 @@
-"""Checkpoint and restart (issue "Hard cases and faults"): a run killed with SIGKILL at arbitrary moments and
+"""Checkpoint and restart: a run killed with SIGKILL at arbitrary moments and
 restarted with --restart each time gives the same result as an uninterrupted run, bit for bit (same thread
 count); SIGINT writes a checkpoint and a readable partial result marked "interrupted"; a bad checkpoint is
 refused with its own exit status."""

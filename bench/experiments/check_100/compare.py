@@ -1,4 +1,4 @@
-"""The issue "Performance" check at 100 x 100 d: `make bench-paper`'s variant (lumped, dt_factor 0.22,
+"""The check at 100 x 100 d: `make bench-paper`'s variant (lumped, dt_factor 0.22,
 damping_cap 0.5, static_start 0.95) against the same scheme from rest (the unaccelerated lumped run), theta_D = 30
 (21.4, 10), to Delta_a = 30 d.
 
@@ -43,7 +43,7 @@ def record_of(run_dir: pathlib.Path, name: str) -> dict:
     meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
     meta.update(history_end(result_file(run_dir)))
     import h5py
-    with h5py.File(result_file(run_dir), "r") as f:  # the scene (issue 16): reach against Delta_a
+    with h5py.File(result_file(run_dir), "r") as f:  # the scene (studies/scene/): reach against Delta_a
         h = f["history"]
         da_h, reach, step_h = np.asarray(h["da_over_d"]), np.asarray(h["inelastic_reach_over_d"]), np.asarray(h["step"])
     scene = [(float(d), float(reach[np.argmax(da_h >= d)])) for d in (0.0, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
