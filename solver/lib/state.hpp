@@ -65,9 +65,12 @@ struct Materials {
 /// element's stiffness (and consistent-minus-lumped mass) when it is deleted.
 struct Operators {
   SpMat K, M;
-  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s).
+  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s),
+  // and its slope d shape / d(x/w_s): -1 on the top row, +1 on the bottom row (per DOF, because the shape's
+  // sign cannot tell the rows apart at x = w_s, where it is +/-0).
   std::vector<int> prescribedDofs;
   std::vector<double> prescribedShape;
+  std::vector<double> prescribedSlope;
   std::vector<int> freeDofs;
   std::vector<int> dofToFree;                    // index into freeDofs; -1 for prescribed
   std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack
