@@ -134,8 +134,10 @@ SOLVER_SOURCES := $(wildcard solver/lib/*.cpp solver/lib/*.hpp solver/app/*.cpp)
 $(ENAMEL): $(SOLVER_SOURCES) | deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target enamel-dem
 
-# Which figure uses which case: generated from paper_cases/figures.toml (FIG4_CASES, ..., ALL_CASES, ALL_SLOW).
-$(BUILD_DIR)/figures.mk: paper_cases/figures.toml pipeline/make_rules.py enamel_results/paths.py
+# Which figure uses which case: generated from the table next to each figure script, figures/figN_<name>.toml
+# (FIG4_CASES, ..., FIGURES, ALL_CASES, ALL_SLOW); a new figures/figN_<name>.py with its .toml joins by itself.
+$(BUILD_DIR)/figures.mk: $(wildcard figures/fig*_*.toml figures/fig*_*.py) pipeline/make_rules.py enamel_results/paths.py \
+    enamel_results/cases.py
 	$(PYTHON) -m pipeline.make_rules $@
 -include $(BUILD_DIR)/figures.mk
 

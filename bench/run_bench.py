@@ -42,6 +42,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
 from enamel_results import metrics, paths, results  # noqa: E402
+from enamel_results.records import history_end  # noqa: E402
+from enamel_results.constants import KINETIC_WARN  # noqa: E402  the solver's quasi-static warning bound
 from figures import plotting  # noqa: E402
 
 ERROR_BOUND = 0.02   # R-curve relative L2 difference from the reference: "within the error bound"
@@ -180,16 +182,6 @@ def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
             f"{j.cpu_s:.1f} s CPU")
 
 
-def history_end(result_h5) -> dict:
-    """The last /history row's applied displacement, time and energy-balance error (results.load_result
-    reads /meta and the R-curve, not these)."""
-    import h5py
-    with h5py.File(result_h5, "r") as f:
-        h = f["history"]
-        return dict(U_end=float(h["applied_displacement"][-1]), t_end=float(h["time"][-1]),
-                    balance_end=float(h["energy_balance_error"][-1]))
-
-
 # ------------------------------------------------------------------------------------------- speed vs error
 def speed_error_jobs(cases, variants, preset, runs: pathlib.Path, extra_sets: dict) -> list[Job]:
     jobs = []
@@ -296,9 +288,6 @@ def write_csv(rows: list[dict], path: pathlib.Path) -> None:
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
     print(path)
-
-
-KINETIC_WARN = 0.05  # the solver's quasi-static warning threshold (runner.cpp kKineticWarn)
 
 
 def within_bound(row) -> bool:
