@@ -25,7 +25,8 @@ import tempfile
 import numpy as np
 
 from bench.experiments.check_100.compare import result_file  # the result-file fallback: to enamel_results' one resolver
-from enamel_results import metrics, records
+from enamel_results import metrics
+from enamel_results import records as run_records
 from enamel_results.records import R_at
 from enamel_results.paths import PAPER_CASES
 
@@ -238,7 +239,7 @@ def main(argv=None) -> int:
             print(f"compare: {failed} run(s) did not complete; their records are not written", file=sys.stderr)
     for item in args.run:
         name, _, run = item.partition("=")
-        record = records.record_of(result_file(pathlib.Path(run)), name)
+        record = run_records.record_of(result_file(pathlib.Path(run)), name)
         record.update(scene_of(pathlib.Path(run)))
         (args.out / f"record_{name}.json").write_text(json.dumps(record, indent=1) + "\n")
     if args.elastic:

@@ -19,7 +19,8 @@ import sys
 
 import numpy as np
 
-from enamel_results import metrics, records
+from enamel_results import metrics
+from enamel_results import records as run_records
 from enamel_results.records import R_at
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -36,7 +37,7 @@ def result_file(run_dir: pathlib.Path) -> pathlib.Path:
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
-    return records.record_of(result_file(run_dir), name)
+    return run_records.record_of(result_file(run_dir), name)
 
 
 def report(records: dict) -> str:
