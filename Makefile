@@ -26,9 +26,9 @@
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
 #                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
 #                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
-#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (issue 16; 8 runs, ~3 h on 2
+#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (docs/solver.md; 8 runs, ~3 h on 2
 #                       cores, resumable; FF_RUNS="cv03_full cv03_m2_h22" for some): studies/far_field/record_*.json
-#   make identify       [IDENTIFY_ARGS=...]  issue 17's interface-ductility study: niced resumable runs in
+#   make identify       [IDENTIFY_ARGS=...]  the interface-ductility identification: niced resumable runs in
 #                       runs/identify/, report studies/identify/results.md (studies/identify/README.md)
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
@@ -117,7 +117,7 @@ clean:
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.run_bench --jobs $(JOBS)
 
-# Issue 17: the interface-ductility identification study (studies/identify/README.md); resumable, niced runs in
+# The interface-ductility identification study (studies/identify/README.md); resumable, niced runs in
 # runs/identify/, report in studies/identify/. IDENTIFY_ARGS: e.g. --stages ab --stop-starting 02:15.
 identify: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m studies.identify.identify $(IDENTIFY_ARGS)
@@ -130,7 +130,7 @@ bench-step: $(ENAMEL)
 bench-paper: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)
 
-# Issue 16: full and reduced far field of the same cases, one run each, JOBS at a time (studies/far_field/README.md).
+# Full and reduced far field of the same cases, one run each, JOBS at a time (studies/far_field/README.md).
 FF_RUNS ?=
 bench-far-field: $(ENAMEL)
 	$(PYTHON) -m studies.far_field.compare --run-all $(ENAMEL) --jobs $(JOBS) $(if $(FF_RUNS),--only $(FF_RUNS))
@@ -141,8 +141,10 @@ SOLVER_SOURCES := $(wildcard solver/lib/*.cpp solver/lib/*.hpp solver/app/*.cpp)
 $(ENAMEL): $(SOLVER_SOURCES) | deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target enamel-dem
 
-# Which figure uses which case: generated from paper_cases/figures.toml (FIG4_CASES, ..., ALL_CASES, ALL_SLOW).
-$(BUILD_DIR)/figures.mk: paper_cases/figures.toml pipeline/make_rules.py enamel_results/paths.py
+# Which figure uses which case: generated from the table next to each figure script, figures/figN_<name>.toml
+# (FIG4_CASES, ..., FIGURES, ALL_CASES, ALL_SLOW); a new figures/figN_<name>.py with its .toml joins by itself.
+$(BUILD_DIR)/figures.mk: $(wildcard figures/fig*_*.toml figures/fig*_*.py) pipeline/make_rules.py enamel_results/paths.py \
+    enamel_results/cases.py
 	$(PYTHON) -m pipeline.make_rules $@
 -include $(BUILD_DIR)/figures.mk
 

@@ -30,6 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from bench import run_bench  # noqa: E402
+from enamel_results import records  # noqa: E402
 from enamel_results import paper_values, paths, results  # noqa: E402
 from figures import plotting  # noqa: E402
 
@@ -176,7 +177,7 @@ def report() -> int:
     except results.MissingResult:
         print(f"paper_preset.py: no result {h5}: run `make bench-paper` first", file=sys.stderr)
         return results.EXIT_MISSING
-    m, end = r.meta, run_bench.history_end(h5)
+    m, end = r.meta, records.history_end(h5)
     reduced = reduced_results()
     row = bench_row(VARIANT)
     steps, wall, threads, dof = int(m["steps"]), float(m["wall_time_s"]), int(m["threads"]), int(m["dof"])

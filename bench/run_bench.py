@@ -42,6 +42,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
 from enamel_results import metrics, paths, results  # noqa: E402
+from enamel_results.records import history_end  # noqa: E402
+from enamel_results.constants import KINETIC_WARN  # noqa: E402  the solver's quasi-static warning bound
 from figures import plotting  # noqa: E402
 
 ERROR_BOUND = metrics.TOL_RATE_SPEED   # the measure's tolerance for speed checks (metrics.same_rcurve decides)
@@ -72,7 +74,7 @@ VARIANTS = {
     "lumped cap0.5 dt0.22 rate1.5": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=1.5), 1),
     "lumped cap0.5 dt0.22 rate2": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=2), 1),
     "lumped cap0.5 dt0.22 rate4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_factor=4), 1),
-    # fewer steps (issue "Performance"): the static elastic start, the adaptive loading rate, both
+    # fewer steps: the static elastic start, the adaptive loading rate, both
     "lumped cap0.5 dt0.22 static": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95), 1),
     "lumped cap0.5 dt0.22 adapt4": (lumped(dt_factor=0.22, damping_cap=0.5, rate_adapt_max=4), 1),
     "lumped cap0.5 dt0.22 static rate2": (lumped(dt_factor=0.22, damping_cap=0.5, static_start=0.95, rate_factor=2),
@@ -180,16 +182,6 @@ def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
         free += j.cores
         log(f"[{time.perf_counter() - t_all:7.0f} s] {j.key}: exit {j.returncode}, {j.wall_s:.1f} s wall, "
             f"{j.cpu_s:.1f} s CPU")
-
-
-def history_end(result_h5) -> dict:
-    """The last /history row's applied displacement, time and energy-balance error (results.load_result
-    reads /meta and the R-curve, not these)."""
-    import h5py
-    with h5py.File(result_h5, "r") as f:
-        h = f["history"]
-        return dict(U_end=float(h["applied_displacement"][-1]), t_end=float(h["time"][-1]),
-                    balance_end=float(h["energy_balance_error"][-1]))
 
 
 # ------------------------------------------------------------------------------------------- speed vs error
@@ -303,9 +295,6 @@ def write_csv(rows: list[dict], path: pathlib.Path) -> None:
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
     print(path)
-
-
-KINETIC_WARN = 0.05  # the solver's quasi-static warning threshold (runner.cpp kKineticWarn)
 
 
 def within_bound(row) -> bool:

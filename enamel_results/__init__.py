@@ -1,7 +1,8 @@
 """enamel_results: the Python side's library for enamel-dem's HDF5 results (no plotting).
 
     paths          the one place that defines the pipeline's paths (paper_cases/, runs/, figures/out/, bench/)
-    cases          paper_cases/figures.toml (which figure uses which case) and parameters from case names
+    cases          the figure tables figures/figN_<name>.toml (which figure uses which case), case-name parameters
+    constants      the numbers shared with the solver (exit codes, the kinetic/strain warning bound)
     paper_values   figures/paper_values.toml: the numbers the paper states, with their sentences
     results        load one result.h5 (Result, Geometry, Frame), interface tags, EXIT_MISSING
     metrics        R-curve comparison and the pooled R_m of Fig. 9

@@ -1,12 +1,15 @@
-"""Which figure uses which case (paper_cases/figures.toml) and the parameters in a paper case's name."""
+"""Which figure uses which case (the table next to each figure script, figures/figN_<name>.toml) and the
+parameters in a paper case's name."""
 from __future__ import annotations
 
+import pathlib
 import re
 import tomllib
 
 from enamel_results import paths
 
-PARAM_KEYS = ("theta_D", "sigma_ru_over_sigma0", "Er_over_kd", "cv", "seed")
+FIGURES_DIR = paths.ROOT / "figures"
+FIGURE_SCRIPT = re.compile(r"^(fig\d+)_\w+$")  # figures/fig4_decussation.py -> figure "fig4"
 
 
 def load_toml(path) -> dict:
@@ -14,9 +17,28 @@ def load_toml(path) -> dict:
         return tomllib.load(f)
 
 
-def figure_list() -> dict:
-    """paper_cases/figures.toml: {fig: {"cases": [...], "slow": [...]}}."""
-    return load_toml(paths.FIGURE_LIST)
+def figure_scripts(figures_dir: pathlib.Path = FIGURES_DIR) -> dict[str, str]:
+    """{figure: script stem} for every figures/figN_<name>.py, in figure order (fig4 ... fig9, then any added)."""
+    found = {}
+    for p in figures_dir.glob("fig*_*.py"):
+        m = FIGURE_SCRIPT.match(p.stem)
+        if m:
+            if m[1] in found:
+                raise ValueError(f"{figures_dir}: two scripts for {m[1]}: {found[m[1]]}.py and {p.name}")
+            found[m[1]] = p.stem
+    return dict(sorted(found.items(), key=lambda kv: int(kv[0][3:])))
+
+
+def figure_list(figures_dir: pathlib.Path = FIGURES_DIR) -> dict:
+    """{figure: {"cases": [...], "slow": [...]}} from the table next to each figure script (figN_<name>.toml);
+    a script without its table is an error naming the file it needs."""
+    tables = {}
+    for fig, stem in figure_scripts(figures_dir).items():
+        table = figures_dir / f"{stem}.toml"
+        if not table.exists():
+            raise FileNotFoundError(f"{figures_dir / (stem + '.py')} has no table of cases: {table} is missing")
+        tables[fig] = load_toml(table)
+    return tables
 
 
 def figure_cases(fig: str) -> list[str]:

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fig. 7: initiation toughness R_init/Gamma_i and steady-state crack resistance R_ss/Gamma_i against the
 decussation angle theta_D, the rod strength sigma_ru/sigma0 and the stiffness contrast Er/kd (the 36 cases of
-figures.toml [fig7]).
+figures/fig7_summary.toml).
 
 Rows: R_init, R_ss; columns: Er/kd = 5, 10, 20; horizontal axis sigma_ru/sigma0; one line per theta_D. The
 parameters come from each result's /meta case_toml. R_init is the first R with Delta_a > 0; R_ss is our

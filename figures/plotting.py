@@ -174,7 +174,7 @@ def title_with_status(ax, text: str, r: Result) -> None:
 
 
 def map_figure(script: str, fig_key: str, description: str, row_keys: tuple, suptitle: str) -> None:
-    """Figs. 4, 5, 6: one row per case of figures.toml [fig_key]: three process-zone maps and the R-curve,
+    """Figs. 4, 5, 6: one row per case of the figure's table (figures/figN_<name>.toml): three process-zone maps and the R-curve,
     with the half-rate twin and the paper's numbers on the R-curve."""
     parser = cli.argument_parser(description, maps=True)
     args = parser.parse_args()

@@ -7,7 +7,7 @@ case, figures, theta_D, sigma_ru_over_sigma0, Er_over_kd, cv, seed, loading (pre
 da_max_over_d, R_init_over_Gamma, R_ss_over_Gamma, R_m_over_Gamma, dR_m_over_Gamma,
 da_first_rod_fracture_over_d, broken_rod_elements (last /history row), wall_time_s, and paper_<quantity> for
 each quantity the paper states for that case (several values joined by ';', a lower bound written '>=X').
-Half-rate twins (figures.toml `slow`) get their own rows where their result file exists.
+Half-rate twins (a figure table's `slow`) get their own rows where their result file exists.
 Reads runs/PRESET/<case>/result.h5 only.
 """
 import csv

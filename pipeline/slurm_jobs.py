@@ -9,7 +9,7 @@ it wrote; run OUT/submit.sh on the cluster's login node to submit both (it print
 
 Each array task builds its runs/P/<run>/result.h5 with `make` through the same Make rule as `make runs`, so a
 task that starts again continues its run from the run's checkpoint. The runs are the figure set's cases and
-their half-rate `<case>_slow` twins (paper_cases/figures.toml, as make_rules.py reads it); --cases keeps some.
+their half-rate `<case>_slow` twins (the figure tables figures/figN_<name>.toml, as make_rules.py reads them); --cases keeps some.
 
 Signals. Before the time limit SLURM sends the batch shell SIGUSR1 (--signal-seconds ahead); the shell passes
 SIGTERM to the process group of make and the solver, the solver writes a checkpoint and exits, and the task
@@ -59,12 +59,12 @@ def select_runs(cases: list[str] | None) -> list[str]:
     _, all_cases, all_slow = figure_set()
     runs = all_cases + [f"{c}_slow" for c in all_slow]
     if not runs:
-        fail(f"{paths.FIGURE_LIST} lists no runs")
+        fail("the figure tables (figures/figN_<name>.toml) list no runs")
     if cases is None:
         return runs
     unknown = [c for c in cases if c not in runs]
     if unknown:
-        fail(f"'{unknown[0]}' is not a run of the figure set ({paths.FIGURE_LIST}: a case, or <case>_slow for "
+        fail(f"'{unknown[0]}' is not a run of the figure set (the figure tables figures/figN_<name>.toml: a case, or <case>_slow for "
              "a half-rate twin)")
     if not cases:
         fail("--cases given without any run")

@@ -1,5 +1,5 @@
 #pragma once
-// 3D Euler-Bernoulli beam element for the enamel rods (DESIGN.md sections 2-4), as pure functions:
+// 3D Euler-Bernoulli beam element for the enamel rods (docs/model.md), as pure functions:
 // section properties, local frame, local/global stiffness and mass, end forces, the brittle stress
 // check and the element eigenfrequencies that set the stable time step.
 // GCC 12 emits a known false-positive -Wmaybe-uninitialized from Eigen's self-adjoint eigensolver
@@ -63,7 +63,7 @@ Mat12 globalConsistentMass(const Section& s, const Vec3& xa, const Vec3& xb);
 // internal-force contribution to the global residual is +T^T f_local (M a + K u = f_ext).
 Vec12 localEndForces(const Section& s, double L, const Mat3& R, const Vec12& uGlobal);
 
-// Brittle check (DESIGN section 3): max over both ends of
+// Brittle check (docs/model.md): max over both ends of
 //   sigma = N/A + sqrt((My c/Iy)^2 + (Mz c/Iz)^2),  N = f_local[6] = -f_local[0] (tension positive),
 // end moments (My, Mz) = f_local[4,5] at node a and f_local[10,11] at node b.
 double maxTensileStress(const Section& s, const Vec12& fLocal);

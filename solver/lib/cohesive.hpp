@@ -1,6 +1,6 @@
 #pragma once
 // Interface cohesive law (symmetric trapezoid) and the rigid-arm interface element, as pure functions.
-// DESIGN.md section 3 (Interfaces). Normalised units (d = 1, E_r = 1, rho_r = 1).
+// docs/model.md. Normalised units (d = 1, E_r = 1, rho_r = 1).
 #include <Eigen/Dense>
 
 namespace enamel::cohesive {
@@ -12,7 +12,7 @@ using Mat3 = Eigen::Matrix3d;
 // delta1, linear to zero at deltaf = delta1 + L, L = softeningOverDelta0 * delta0 (case key
 // softening_over_delta0). Area = Gamma:
 //   Gamma = sigma0 delta0/2 + sigma0 (delta1 - delta0) + sigma0 L/2  =>  delta1 = Gamma/sigma0 + (delta0 - L)/2.
-// Default L = delta0 (the symmetric trapezoid of DESIGN.md 3): delta1 = Gamma/sigma0, deltaf = delta1 + delta0,
+// Default L = delta0 (the symmetric trapezoid of docs/model.md): delta1 = Gamma/sigma0, deltaf = delta1 + delta0,
 // and the same floating-point numbers as before the key (delta0 - 1.0*delta0 = 0 exactly). Requires
 // delta1 >= delta0, i.e. L/delta0 <= 2 G - 1 with G = Gamma k/sigma0^2 (equality: the triangle, no plateau).
 struct Law {

@@ -1,5 +1,5 @@
 #pragma once
-// The reduced far field (issue "Model only what a scene needs"; README "Reduced far field").
+// The reduced far field (docs/solver.md, "Reduced far field").
 //
 // Away from the crack plane the material stays elastic (studies/scene/README.md), so it need not be resolved
 // slice by slice. coarsenFarField keeps the full model inside the band |y - y_crack| <= fullHalfHeight and,

@@ -21,7 +21,7 @@ Vec3 Model::rodDirection(int ply) const {
   return Vec3(std::cos(theta), sign * std::sin(theta), 0.0);
 }
 
-// Rod centre lines (DESIGN section 2), with the origin of x put on a crisscross point of the mid-plane:
+// Rod centre lines (docs/model.md), with the origin of x put on a crisscross point of the mid-plane:
 //   ply 1:  y = yCrack + j s + (x - xCrisscross) tan(theta)
 //   ply 2:  y = yCrack + j s - (x - xCrisscross) tan(theta)
 // so that rod 0 of both plies crosses the mid-plane at xCrisscross. At theta = 0 there is no crisscross:
@@ -151,12 +151,17 @@ void numberNodesBySlice(Model& m) {
   for (int& n : m.topNodes) n = newId[n];
   for (int& n : m.bottomNodes) n = newId[n];
 }
-Model buildCrossply(const GeometryParams& p) {
+namespace {
+
+void checkGeometryParams(const GeometryParams& p) {
   if (!(p.theta_deg >= 0 && p.theta_deg <= 45)) throw std::invalid_argument("theta_D must be in [0, 45] deg");
   if (!(p.h_e > 0 && p.h_e <= 1)) throw std::invalid_argument("h_e must be in (0, 1] d");
   if (!(p.w_s >= 2 * p.h_e && p.h_s >= 2)) throw std::invalid_argument("specimen too small");
   if (!(p.a0 > 0 && p.a0 < p.w_s)) throw std::invalid_argument("a0 must be in (0, w_s)");
+}
 
+// The model's constants: packing, specimen, slices, crack plane, crisscross point.
+Model modelConstants(const GeometryParams& p) {
   Model m;
   m.theta = p.theta_deg * M_PI / 180.0;
   m.s = m.d / std::cos(m.theta);
@@ -170,12 +175,46 @@ Model buildCrossply(const GeometryParams& p) {
   m.yCrack = 0.5 * p.h_s;
   m.xCrisscross = m.theta > 0 ? p.a0 + p.crisscross_phase * m.d / std::sin(m.theta) : p.a0;
   m.beamLength = m.h_e / std::cos(m.theta);
+  return m;
+}
 
-  // --- rods and nodes: node of rod (ply, j) in slice k exists when its centre lies in [0, h_s) ---
+// One rod (ply, j) with its nodes in slices first .. first + count - 1 and the rod elements between them; a
+// rod element crossing the mid-plane behind the pre-crack tip is cut by the pre-crack.
+void addRod(Model& m, const GeometryParams& p, int ply, int j, int first, int count,
+            std::vector<std::vector<int>>& sliceNodes) {
+  const int rod = m.numRods();
+  m.rodPly.push_back(static_cast<std::int8_t>(ply));
+  m.rodIndex.push_back(j);
+  for (int k = first; k < first + count; ++k) {
+    const double x = k * m.h_e;
+    const int node = m.numNodes();
+    m.X.emplace_back(x, rodCentreY(m, ply, j, x), ply == 0 ? 0.0 : m.t);
+    m.nodeRod.push_back(rod);
+    m.nodeSlice.push_back(k);
+    m.nodePly.push_back(static_cast<std::int8_t>(ply));
+    sliceNodes[k].push_back(node);
+    if (k == first) continue;
+    const double ya = m.X[node - 1].y(), yb = m.X[node].y();
+    const bool crosses = (ya < m.yCrack) != (yb < m.yCrack);
+    if (p.precrack && crosses && x - 0.5 * m.h_e < p.a0) {
+      ++m.precrackBeams;
+      m.precrackBeamRod.push_back(rod);
+      m.precrackBeamSlice.push_back(k - 1);
+    } else {
+      m.beamNodes.push_back({node - 1, node});
+      m.beamRod.push_back(rod);
+      m.beamSpan.push_back(1);
+    }
+  }
+}
+
+// Rods and nodes: the node of rod (ply, j) in slice k exists when its centre lies in [0, h_s); returns the
+// node ids of each slice, sorted by (ply, y).
+std::vector<std::vector<int>> addRodsAndNodes(Model& m, const GeometryParams& p) {
   const double tanT = std::tan(m.theta);
   const int jSpan = static_cast<int>(std::ceil((p.h_s + p.w_s * tanT) / m.s)) + 2;
-  std::vector<std::vector<int>> sliceNodes(m.numSlices);  // per slice, node ids sorted by (ply, y)
-  for (int ply = 0; ply < 2; ++ply) {
+  std::vector<std::vector<int>> sliceNodes(m.numSlices);
+  for (int ply = 0; ply < 2; ++ply)
     for (int j = -jSpan; j <= jSpan; ++j) {
       int first = -1, count = 0;
       for (int k = 0; k < m.numSlices; ++k) {
@@ -185,102 +224,91 @@ Model buildCrossply(const GeometryParams& p) {
           ++count;
         }
       }
-      if (count < 2) continue;  // a rod clipping a corner with a single node would carry no beam
-      const int rod = m.numRods();
-      m.rodPly.push_back(static_cast<std::int8_t>(ply));
-      m.rodIndex.push_back(j);
-      for (int k = first; k < first + count; ++k) {
-        const double x = k * m.h_e;
-        const int node = m.numNodes();
-        m.X.emplace_back(x, rodCentreY(m, ply, j, x), ply == 0 ? 0.0 : m.t);
-        m.nodeRod.push_back(rod);
-        m.nodeSlice.push_back(k);
-        m.nodePly.push_back(static_cast<std::int8_t>(ply));
-        sliceNodes[k].push_back(node);
-        if (k > first) {
-          // Beams crossing the mid-plane behind the pre-crack tip are cut by the pre-crack.
-          const double ya = m.X[node - 1].y(), yb = m.X[node].y();
-          const bool crosses = (ya < m.yCrack) != (yb < m.yCrack);
-          if (p.precrack && crosses && x - 0.5 * m.h_e < p.a0) {
-            ++m.precrackBeams;
-            m.precrackBeamRod.push_back(rod);
-            m.precrackBeamSlice.push_back(k - 1);
-          } else {
-            m.beamNodes.push_back({node - 1, node});
-            m.beamRod.push_back(rod);
-            m.beamSpan.push_back(1);
-          }
-        }
-      }
+      if (count >= 2) addRod(m, p, ply, j, first, count, sliceNodes);  // a single node would carry no beam
     }
-  }
+  return sliceNodes;
+}
 
-  // --- interfaces: Voronoi neighbours in each slice, periodic in z ---
+// One interface between nodes nA (lower z) and nB (+ shift periods in z) at the Voronoi edge's midpoint.
+void addInterface(Model& m, int k, int nA, int nB, int shift, const Vec3& mid, double area, double edgeLength) {
+  const Vec3 xA = m.X[nA], xB = m.X[nB] + Vec3(0, 0, shift * m.B);
+  cohesive::InterfaceGeometry g;
+  const Vec3 nrm = (xB - xA).normalized();
+  const Vec3 t1(1, 0, 0);
+  g.frame.row(0) = nrm;
+  g.frame.row(1) = t1;
+  g.frame.row(2) = nrm.cross(t1);
+  g.armA = mid - xA;
+  g.armB = mid - xB;
+  g.area = area;
+  const int plyA = m.nodePly[nA], plyB = m.nodePly[nB];
+  const std::int8_t tag = plyA == plyB ? (plyA == 0 ? kTagPly1 : kTagPly2) : (plyA == 0 ? kTagInterlayer12 : kTagInterlayer21);
+  m.ifaceNodes.push_back({nA, nB});
+  m.ifaceGeom.push_back(g);
+  m.ifaceTag.push_back(tag);
+  m.ifaceSlice.push_back(k);
+  m.ifaceEdgeLength.push_back(edgeLength);
+  m.ifaceZShift.push_back(static_cast<std::int8_t>(shift));
+}
+
+// The interfaces of slice k: Voronoi neighbours, periodic in z; those across the mid-plane behind the
+// pre-crack tip are the pre-crack.
+void addInterfacesOfSlice(Model& m, const GeometryParams& p, int k, const std::vector<int>& ids) {
+  std::vector<Vec2> pts;
+  pts.reserve(ids.size());
+  for (int id : ids) pts.emplace_back(m.X[id].y(), m.X[id].z());
+  const std::vector<VoronoiCell> cells = computeSliceVoronoi(pts, m.B, 0.0, p.h_s);
+  const double x = k * m.h_e;
+  const double tributary = (k == 0 || k == m.numSlices - 1) ? 0.5 * m.h_e : m.h_e;
+  for (int a = 0; a < static_cast<int>(ids.size()); ++a)
+    for (const VoronoiEdge& e : cells[a].edges) {
+      if (e.neighbour < 0) continue;
+      // Each pair once: from the lower index, or for a pair with itself-free shift, the positive shift.
+      if (e.neighbour < a || (e.neighbour == a && e.zShift < 0)) continue;
+      if (e.neighbour == a) continue;  // a rod's own z-image is never its neighbour in these packings
+      const int A = ids[a], Bn = ids[e.neighbour];
+      // Orient every pair so that the wrap (if any) goes from ply 2 up to ply 1: A = lower z.
+      int nA = A, nB = Bn, shift = e.zShift;
+      const Vec3 xB0 = m.X[Bn] + Vec3(0, 0, e.zShift * m.B);
+      if (xB0.z() < m.X[A].z() || (xB0.z() == m.X[A].z() && xB0.y() < m.X[A].y())) {
+        std::swap(nA, nB);
+        shift = -shift;
+      }
+      const Vec3 xA = m.X[nA], xB = m.X[nB] + Vec3(0, 0, shift * m.B);
+      if (p.precrack && x < p.a0 && (xA.y() < m.yCrack) != (xB.y() < m.yCrack)) {
+        ++m.precrackInterfaces;
+        m.precrackIfaceRods.push_back({m.nodeRod[nA], m.nodeRod[nB]});
+        m.precrackIfaceSlice.push_back(k);
+        continue;
+      }
+      const Vec3 mid(x, e.midpoint.x(), e.midpoint.y() + (nA == A ? 0.0 : shift * m.B));
+      addInterface(m, k, nA, nB, shift, mid, tributary * e.length, e.length);
+    }
+}
+
+// The boundary sets: the extreme node of each ply in a slice.
+void addGripNodesOfSlice(Model& m, const std::vector<int>& ids) {
+  for (int ply = 0; ply < 2; ++ply) {
+    int top = -1, bottom = -1;
+    for (int id : ids) {
+      if (m.nodePly[id] != ply) continue;
+      if (top < 0 || m.X[id].y() > m.X[top].y()) top = id;
+      if (bottom < 0 || m.X[id].y() < m.X[bottom].y()) bottom = id;
+    }
+    if (top >= 0) m.topNodes.push_back(top);
+    if (bottom >= 0) m.bottomNodes.push_back(bottom);
+  }
+}
+
+}  // namespace
+
+Model buildCrossply(const GeometryParams& p) {
+  checkGeometryParams(p);
+  Model m = modelConstants(p);
+  const std::vector<std::vector<int>> sliceNodes = addRodsAndNodes(m, p);
   for (int k = 0; k < m.numSlices; ++k) {
-    const std::vector<int>& ids = sliceNodes[k];
-    std::vector<Vec2> pts;
-    pts.reserve(ids.size());
-    for (int id : ids) pts.emplace_back(m.X[id].y(), m.X[id].z());
-    const std::vector<VoronoiCell> cells = computeSliceVoronoi(pts, m.B, 0.0, p.h_s);
-    const double x = k * m.h_e;
-    const double tributary = (k == 0 || k == m.numSlices - 1) ? 0.5 * m.h_e : m.h_e;
-    for (int a = 0; a < static_cast<int>(ids.size()); ++a) {
-      for (const VoronoiEdge& e : cells[a].edges) {
-        if (e.neighbour < 0) continue;
-        // Each pair once: from the lower index, or for a pair with itself-free shift, the positive shift.
-        if (e.neighbour < a || (e.neighbour == a && e.zShift < 0)) continue;
-        if (e.neighbour == a) continue;  // a rod's own z-image is never its neighbour in these packings
-        const int A = ids[a], Bn = ids[e.neighbour];
-        Vec3 xB = m.X[Bn] + Vec3(0, 0, e.zShift * m.B);
-        // Orient every pair so that the wrap (if any) goes from ply 2 up to ply 1: A = lower z.
-        int nA = A, nB = Bn, shift = e.zShift;
-        Vec3 xA = m.X[A];
-        if (xB.z() < xA.z() || (xB.z() == xA.z() && xB.y() < xA.y())) {
-          std::swap(nA, nB);
-          shift = -shift;
-          xA = m.X[nA];
-          xB = m.X[nB] + Vec3(0, 0, shift * m.B);
-        }
-        const bool behindTip = p.precrack && x < p.a0;
-        const bool acrossPlane = (xA.y() < m.yCrack) != (xB.y() < m.yCrack);
-        if (behindTip && acrossPlane) {
-          ++m.precrackInterfaces;
-          m.precrackIfaceRods.push_back({m.nodeRod[nA], m.nodeRod[nB]});
-          m.precrackIfaceSlice.push_back(k);
-          continue;
-        }
-        const Vec3 mid(x, e.midpoint.x(), e.midpoint.y() + (nA == A ? 0.0 : shift * m.B));
-        cohesive::InterfaceGeometry g;
-        const Vec3 nrm = (xB - xA).normalized();
-        const Vec3 t1(1, 0, 0);
-        g.frame.row(0) = nrm;
-        g.frame.row(1) = t1;
-        g.frame.row(2) = nrm.cross(t1);
-        g.armA = mid - xA;
-        g.armB = mid - xB;
-        g.area = tributary * e.length;
-        const int plyA = m.nodePly[nA], plyB = m.nodePly[nB];
-        std::int8_t tag = plyA == plyB ? (plyA == 0 ? kTagPly1 : kTagPly2)
-                                       : (plyA == 0 ? kTagInterlayer12 : kTagInterlayer21);
-        m.ifaceNodes.push_back({nA, nB});
-        m.ifaceGeom.push_back(g);
-        m.ifaceTag.push_back(tag);
-        m.ifaceSlice.push_back(k);
-        m.ifaceEdgeLength.push_back(e.length);
-        m.ifaceZShift.push_back(static_cast<std::int8_t>(shift));
-      }
-    }
-    // --- boundary sets: the extreme node of each ply in this slice ---
-    for (int ply = 0; ply < 2; ++ply) {
-      int top = -1, bottom = -1;
-      for (int id : ids) {
-        if (m.nodePly[id] != ply) continue;
-        if (top < 0 || m.X[id].y() > m.X[top].y()) top = id;
-        if (bottom < 0 || m.X[id].y() < m.X[bottom].y()) bottom = id;
-      }
-      if (top >= 0) m.topNodes.push_back(top);
-      if (bottom >= 0) m.bottomNodes.push_back(bottom);
-    }
+    addInterfacesOfSlice(m, p, k, sliceNodes[k]);
+    addGripNodesOfSlice(m, sliceNodes[k]);
   }
   numberNodesBySlice(m);
   return m;

@@ -1,5 +1,5 @@
 #pragma once
-// Crossply geometry generator (DESIGN.md section 2).
+// Crossply geometry generator (docs/model.md).
 //
 // Axes: x = crack growth, y = loading (opening), z = ply stacking, periodic with period B = sqrt(3) d.
 // Two plies per period, each one row of rods: ply 1 at z = 0 with rods at +theta, ply 2 at z = t =

@@ -207,7 +207,7 @@ class PaperIntegrator : public Integrator {
   VecX w_, fI_, Kq_, Kw_, Mw_, r_, rf_, af_, aGrip_, vGrip_;
 };
 
-// Rotary-inertia scale for the lumped element (DESIGN section 4): with physical rotary inertia the short
+// Rotary-inertia scale for the lumped element (docs/solver.md): with physical rotary inertia the short
 // beam's rotation modes govern; scaling the rotary inertia up lowers them until the element's highest
 // frequency is set by its translational masses (axial 2c/L, or the bending mode with rotations frozen,
 // sqrt(48 E I / (rho A L^4))), which no rotary scaling can lower. Returns the smallest scale >= 1 within 5% of
@@ -265,7 +265,7 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 
 // K in node blocks for the lumped step: node_blocks.hpp.
 
-// Fast scheme `lumped` (ours, DESIGN section 4): explicit central differences with a diagonal mass.
+// Fast scheme `lumped` (ours, docs/solver.md): explicit central differences with a diagonal mass.
 //   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
 //      alpha rho Ip L / 2 per element end, alpha the smallest scale at which rotations stop governing.
 //   C = a M + b' K with b' = min(b, c/omega_max), c = damping_cap (default 1: the stiffness part's damping

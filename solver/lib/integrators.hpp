@@ -4,25 +4,13 @@
 // factorisation, scratch); it is given the set-up data by const reference and the State by reference.
 #include <cmath>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include "case_params.hpp"
+#include "errors.hpp"  // IntegratorError, SolverError (kept here for the files that include them through this one)
 #include "state.hpp"
 
 namespace enamel {
-
-/// A case the scheme cannot run (a time step above the stable limit, a node without mass, an unknown
-/// scheme): bad input, the message says which.
-struct IntegratorError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-/// A numerical failure while setting up or running (a factorisation that failed, an operator without the
-/// structure the scheme relies on): the run failed, the input was not refused.
-struct SolverError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// A time integrator: advances the State by one step.
 class Integrator {

@@ -4,7 +4,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "integrators.hpp"
+#include "errors.hpp"
 
 namespace enamel {
 

@@ -59,10 +59,9 @@ std::string percent(double fraction) {
   return buf;
 }
 
-ByteCounts countBytes(const Simulation& sim) {
-  const Model& m = sim.model;
+ByteCounts countBytes(const Model& m, const Operators& ops) {
   const double ni = m.numInterfaces(), nn = m.numNodes(), ne = m.numBeams();
-  const double ends = static_cast<double>(sim.ops.nodeIfaceList.size());
+  const double ends = static_cast<double>(ops.nodeIfaceList.size());
   const double blocks = 2.0 * ne + nn;  // K: one diagonal block per node, two off-diagonal per rod element
   ByteCounts b;
   // per interface: compact geometry (56), its two nodes (8), lambdaMax read and written (16)
@@ -92,7 +91,7 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
   p.steps = steps;
   p.dof = sim.model.numDofs();
   for (long i = 0; i < warmup; ++i) sim.step();
-  const ByteCounts bytes = countBytes(sim);
+  const ByteCounts bytes = countBytes(sim.model, sim.ops);
   const Model& m = sim.model;
   State& s = sim.state;
   VecX f;

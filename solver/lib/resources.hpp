@@ -1,6 +1,6 @@
 #pragma once
 // What a case will need before anything is built: counts of the model from the case keys alone, and the
-// memory of a run from them (issue "Ecosystem and robustness": a case that cannot fit is refused with the
+// memory of a run from them (a case that cannot fit is refused with the
 // memory needed and the memory available, before anything is allocated or written; cluster jobs ask for it).
 #include <string>
 
@@ -8,7 +8,7 @@
 
 namespace enamel {
 
-/// Counts of the model a case builds, from the geometry's own rules (DESIGN section 2), in double precision
+/// Counts of the model a case builds, from the geometry's own rules (docs/model.md), in double precision
 /// so that an absurd case (h_e = 1e-9 d, a 2000 d specimen) gives a large number instead of an overflow.
 struct ResourceEstimate {
   double slices = 0;       // w_s / h_e + 1

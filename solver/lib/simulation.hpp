@@ -1,7 +1,8 @@
 #pragma once
-// The simulation: the plain data of a run (state.hpp) and its integrator, the level above a scheme's step
-// (rod deletions, crack tracking), and the measurements (J at the outer boundary, crack advance, energy
-// balance). DESIGN.md sections 3-5.
+// The simulation: the plain data of a run (state.hpp), built by the named set-up steps of setup.hpp, and its
+// integrator; the level above a scheme's step (rod deletions, crack tracking) and the static elastic start.
+// The measurements are free functions over the plain data (measurements.hpp); the members below that name
+// them apply them to this run's data.
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -10,7 +11,9 @@
 #include "case_params.hpp"
 #include "integrators.hpp"
 #include "kernels.hpp"
+#include "setup.hpp"         // measureTransverseModulus
 #include "state.hpp"
+#include "static_solve.hpp"  // solveStaticPrescribed, computeFirstDamageDisplacement
 
 namespace enamel {
 
@@ -39,13 +42,6 @@ struct StaticStart {
                                          // strain (solveStaticPrescribed) stayed where it was
   double solveSeconds = 0;               // wall time of the static solve and the start state (set by the runner)
 };
-
-/// U_c of a static elastic displacement field q1 at unit applied displacement (linear: every opening and rod
-/// stress scales with U): the smallest of delta0 / max_i lambda_i(q1) over the interfaces (when breakable)
-/// and 1 / max_e sigma_e(q1) / sigma_ru,e over the intact rod elements (when breakable); infinite when
-/// nothing opens or is stressed. limitedByRod says which set it.
-double computeFirstDamageDisplacement(const Model& m, const Materials& mat, const VecX& q1,
-                                      const std::vector<std::uint8_t>& beamBroken, bool interfacesBreakable, bool& limitedByRod);
 
 /// Worker threads the force loops use (set from the case key `threads` when a Simulation is built).
 int threadCount();
@@ -86,9 +82,9 @@ class Simulation {
   /// Throws IntegratorError when U_c is not finite and positive (nothing opens: no damage to start before).
   StaticStart startFromStaticElastic(double fraction);
 
-  // --- measurements ---
+  // --- measurements (measurements.hpp) on this run's data ---
   Measurement measure() const;
-  double computeJ() const;                 // J at the outer boundary (DESIGN section 5)
+  double computeJ() const;                 // J at the outer boundary (docs/model.md)
   double measureCrackAdvance() const;      // Delta a of the cluster of failed elements touching the pre-crack
   double strainEnergyOfBeams() const;      // 1/2 q^T K q
   double strainEnergyOfInterfaces() const;
@@ -105,16 +101,5 @@ class Simulation {
   std::vector<double> beamStressRatio_;  // scratch: sigma / sigma_ru per rod element
   StressCheckSchedule stressSchedule_;   // scratch: which rod elements the deletion check computes
 };
-
-/// Measure E_transverse (modulus in the loading direction y) with the model itself: a static uniaxial
-/// stretch of an uncracked block of the same microstructure, rods plus elastic interfaces, top and bottom
-/// rows displaced by +/- delta/2, everything else free (one node fixed in x and z against rigid motion).
-double measureTransverseModulus(const CaseParams& p, double* blockStrain = nullptr);
-
-/// Static solution of K u = 0 with u prescribed (= values) at `dofs` (CHOLMOD on the free partition). Where
-/// the free partition is only semi-definite (a mechanism: a part free to move without straining anything),
-/// the mechanism stays where it is and `mechanism`, if given, is set.
-VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values,
-                           bool* mechanism = nullptr);
 
 }  // namespace enamel

@@ -1,5 +1,5 @@
 #pragma once
-// The plain data a run is made of (DESIGN.md sections 3-5), in four parts that change at different rates:
+// The plain data a run is made of (docs/model.md), in four parts that change at different rates:
 //   Model      the geometry (geometry.hpp): nodes, rod elements, interfaces; never changes
 //   Materials  what the rods and interfaces are made of, how the specimen is damped and loaded; never changes
 //   Operators  the assembled rod matrices K, M (rod deletions change them), DOF maps, interface adjacency
@@ -22,7 +22,7 @@ namespace enamel {
 using VecX = Eigen::VectorXd;
 using SpMat = Eigen::SparseMatrix<double>;
 
-/// Graded velocity loading on the top and bottom boundary rows (DESIGN section 4):
+/// Graded velocity loading on the top and bottom boundary rows (docs/solver.md):
 ///   u_y = +/- U(t) (1 - x / w_s),  U' = v_app r(t),  r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
 /// With an adaptive rate (rateAdaptMax > 1, loading_rate.hpp) the argument is the loading clock tau, not t.
 struct Loading {
@@ -65,9 +65,12 @@ struct Materials {
 /// element's stiffness (and consistent-minus-lumped mass) when it is deleted.
 struct Operators {
   SpMat K, M;
-  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s).
+  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s),
+  // and its slope d shape / d(x/w_s): -1 on the top row, +1 on the bottom row (per DOF, because the shape's
+  // sign cannot tell the rows apart at x = w_s, where it is +/-0).
   std::vector<int> prescribedDofs;
   std::vector<double> prescribedShape;
+  std::vector<double> prescribedSlope;
   std::vector<int> freeDofs;
   std::vector<int> dofToFree;                    // index into freeDofs; -1 for prescribed
   std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack

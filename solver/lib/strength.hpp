@@ -1,5 +1,5 @@
 // Rod-element strengths: one per rod element, normal distribution (mean, cv), seeded, negative
-// draws redrawn (DESIGN.md 3). Our own Box-Muller transform on std::mt19937_64, because
+// draws redrawn (docs/model.md). Our own Box-Muller transform on std::mt19937_64, because
 // std::normal_distribution differs between standard libraries and the seed must reproduce a run.
 #pragma once
 

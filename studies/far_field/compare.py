@@ -1,4 +1,4 @@
-"""The reduced far field (issue "Model only what a scene needs"; README "Reduced far field") against the full
+"""The reduced far field (docs/solver.md, "Reduced far field") against the full
 model at 80 x 80 d, theta_D = 30 (21.4, 10), `make bench-paper`'s variant (lumped, dt_factor 0.22, damping_cap
 0.5, static_start 0.95), 1 thread, to Delta_a = 30 d.
 
@@ -24,8 +24,10 @@ import tempfile
 
 import numpy as np
 
-from bench.experiments.check_100.compare import R_at, record_of, result_file
+from bench.experiments.check_100.compare import result_file  # the result-file fallback: to enamel_results' one resolver
 from enamel_results import metrics
+from enamel_results import records as run_records
+from enamel_results.records import R_at
 from enamel_results.paths import PAPER_CASES
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -137,7 +139,7 @@ def by_case(records: dict) -> dict:
 
 
 def scene_of(run_dir: pathlib.Path) -> dict:
-    """Where the damage is at the run's last frame (issue 16, item 1): the distances from the crack plane of the
+    """Where the damage is at the run's last frame (studies/scene/): the distances from the crack plane of the
     deleted rod elements (sorted) and of the interfaces with damage > 0 (largest, 99th percentile)."""
     import h5py
     with h5py.File(result_file(run_dir), "r") as f:
@@ -237,7 +239,7 @@ def main(argv=None) -> int:
             print(f"compare: {failed} run(s) did not complete; their records are not written", file=sys.stderr)
     for item in args.run:
         name, _, run = item.partition("=")
-        record = record_of(pathlib.Path(run), name)
+        record = run_records.record_of(result_file(pathlib.Path(run)), name)
         record.update(scene_of(pathlib.Path(run)))
         (args.out / f"record_{name}.json").write_text(json.dumps(record, indent=1) + "\n")
     if args.elastic:

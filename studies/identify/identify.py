@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""`make identify`: the interface-ductility identification study of issue 17 ("Fidelity").
+"""`make identify`: the interface-ductility identification study (README.md here).
 
 Runs theta30 (21.4, 10) at Gamma_k_over_sigma0sq = G over specimen sizes and two meshes, then the validation
 cases for the candidate values, and writes the report (studies/identify/results.md, results.csv, PNG figures).
@@ -64,7 +64,7 @@ PRESET = "reduced"
 PAPER_RSS = 7.0        # the rule's target (Sec. 3); Sec. 5 gives ~8 for the same case (reported, not used)
 CONVERGED_L2 = 0.05    # the paper's "did not affect the calculation results", read as 5% relative L2
 RUNS = ROOT / "runs" / "identify"
-# Committed per-run data (README "Changes to the plan" 6): runs/ does not survive a session, so every completed
+# Committed per-run data (README "Changes to the plan" 6): runs/ does not survive the machine, so every completed
 # run's metrics, R-curve and broken-element positions are kept here (one small JSON file per run) and the report
 # uses them for every run whose folder is absent.
 DATA = HERE / "data"
@@ -204,7 +204,7 @@ def _sig(v: float) -> float:
 
 def store(m: dict, data: pathlib.Path = DATA) -> pathlib.Path:
     """Write (or replace) the committed record of a run read from its folder. A record of an earlier run of the
-    same key is kept in "previous" (its metrics and session), so a re-run never loses what was measured."""
+    same key is kept in "previous" (its metrics and when it was made), so a re-run never loses what was measured."""
     path = data_path(m["size"], m["h_e"], m["G"], m["case"], data)
     previous = []
     if path.is_file():
@@ -224,7 +224,7 @@ def store(m: dict, data: pathlib.Path = DATA) -> pathlib.Path:
 
 
 def stored(size: str, he: float, G: float, case: str, data: pathlib.Path = DATA) -> dict | None:
-    """A run's row from its committed record (None: no record). Records of the first session (runs made before the
+    """A run's row from its committed record (None: no record). Records of the first round (runs made before the
     data were kept) hold the metrics only: no R-curve (da/R None) and no broken-element positions."""
     path = data_path(size, he, G, case, data)
     if not path.is_file():
@@ -315,7 +315,7 @@ def candidates(runs: pathlib.Path, n: int = 2) -> list[float]:
 def run_all(plan, args) -> None:
     """Run the jobs of plan() in order, at most args.jobs at once, none started after args.stop_starting; skip
     finished ones. plan() is re-evaluated each time a slot frees, so a queue that depends on results (stage p:
-    the candidates) uses every run finished by then; a run that failed is not retried in this session."""
+    the candidates) uses every run finished by then; a run that failed is not retried in this invocation."""
     running, tried = [], set()
 
     def too_late():
@@ -391,7 +391,7 @@ def run_key(m: dict) -> str:
 
 def read_pairs(data: pathlib.Path = DATA) -> dict:
     """Committed distances between two runs' R-curves that can no longer be computed (data/pairs.csv: the runs of
-    the first session, whose curves were not kept): (run, reference run) -> (L2, mean-R difference, session)."""
+    the first round, whose curves were not kept): (run, reference run) -> (L2, mean-R difference, when made)."""
     out = {}
     f = data / "pairs.csv"
     if f.is_file():
@@ -524,7 +524,7 @@ def validation(rows, G) -> list[tuple[str, str, str]]:
     if hi:
         if has_curve(hi):
             R2, R4, R6 = (float(np.interp(a, hi["da"], hi["R"])) for a in (2, 4, 6))
-        else:  # a committed record without its curve: the values the first session's report gave
+        else:  # a committed record without its curve: the values the first round's report gave
             R2, R4, R6 = (float(hi["R_at_stored"].get(k, math.nan)) for k in ("2", "4", "6"))
         out.append(("7. theta30 (28.5, 10): R flat to ~4 d, rising after", f"R(2,4,6 d) = {R2:.2f}, {R4:.2f}, {R6:.2f}",
                     verdict(R4 - R2 < R6 - R4)))
@@ -538,8 +538,8 @@ def figures(rows, conv, out_dir: pathlib.Path) -> list[str]:
     main = [m for m in rows if m["case"] == MAIN_CASE]
     panels = [("ci", 0.3), ("red", 0.3), ("red", 0.15), ("big", 0.3)]
     missing = [m for m in main if not has_curve(m)]
-    nocurve = ("" if not missing else "\nnot drawn (committed without their curve, runs of the first session: "
-               "see data/session1/): " + ", ".join(f"{m['size']} h_e {m['h_e']:g} G {m['G']:g}" for m in missing))
+    nocurve = ("" if not missing else "\nnot drawn (committed without their curve, runs of the first round: "
+               "see data/round1/): " + ", ".join(f"{m['size']} h_e {m['h_e']:g} G {m['G']:g}" for m in missing))
     fig, axes = plt.subplots(1, 4, figsize=(16, 4.2), sharey=True)
     cmap = plt.get_cmap("viridis")
     for ax, (size, he) in zip(axes, panels):
@@ -666,7 +666,7 @@ def report(args) -> None:
     L = [f"# Identification study: results (generated by `make identify`, {datetime.datetime.now():%F %H:%M})", "",
          "Plan, metrics and the rule: `README.md` (written first). Every number below is from a run folder "
          "under `runs/identify/` (not committed) when present, else from the run's committed record in `data/` "
-         "(column \"from\": *committed*, with the session of the run; README \"Changes to the plan\" 6); "
+         "(column \"from\": *committed*, with when and with which solver the run was made; README \"Changes to the plan\" 6); "
          "`results.csv` and `convergence.csv` hold them all.", "",
          "## Runs", "",
          "| case | size | h_e | G | l/d | delta_f/d | status | Delta_a | R_init | R(3 d) | R_ss | R_m | broken | "
@@ -695,7 +695,7 @@ def report(args) -> None:
     notes = [f"G = {c['G']:g}: {c['note']}" for c in conv if c["note"]]
     if notes:
         L += ["", "Distances taken from the committed `data/pairs.csv` (a run of the pair has no kept curve, so "
-              "the pair's distance is the one its own session measured): " + "; ".join(notes) + "."]
+              "the pair's distance is the one its own round measured): " + "; ".join(notes) + "."]
     L += ["", "## Selection (the README's rule, applied as written)", ""]
     if sel:
         L.append(f"**Selected: G = {sel['G']:g}** (converged; theta30 (21.4, 10) R_ss {sel['R_ss_largest']:.2f} at "

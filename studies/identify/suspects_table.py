@@ -1,4 +1,4 @@
-"""Rows of studies/identify/suspects.md from runs/suspects/<name>/result.h5 (issue 17 item 4).
+"""Rows of studies/identify/suspects.md from runs/suspects/<name>/result.h5.
 
     /usr/bin/python3 -m studies.identify.suspects_table [NAME ...]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measure the scene (issue "Model only what a scene needs", item 1): how far from the crack the material
+"""Measure the scene: how far from the crack the material
 leaves its elastic range, frame by frame, in finished (or partial) result files.
 
 For each frame of each result file given (/frames/<n>: interface state, rod stress; /geometry):

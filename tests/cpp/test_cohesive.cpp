@@ -16,7 +16,7 @@ using namespace enamel::cohesive;
 
 namespace {
 
-// Normalised defaults of DESIGN.md section 1: Er/(k d) = 10 -> k = 0.1; delta0/d = 1e-3 -> sigma0 = 1e-4;
+// Normalised values (docs/model.md, units): Er/(k d) = 10 -> k = 0.1; delta0/d = 1e-3 -> sigma0 = 1e-4;
 // Gamma k / sigma0^2 = 3 -> Gamma = 3e-7. So delta0 = 1e-3, delta1 = 3e-3, deltaf = 4e-3.
 const Law kLaw = makeLaw(0.1, 1e-4, 3e-7);
 

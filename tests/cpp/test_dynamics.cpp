@@ -1,4 +1,4 @@
-// Dynamics of the time integrators against theory (issue "Reference solver"): the axial wave speed of the
+// Dynamics of the time integrators against theory: the axial wave speed of the
 // rods, the energy balance of an undamped elastic run, and the damping ratio of a single mode.
 //
 // At theta_D = 0 the rods run along x. A field u_x(x) that is the same in every rod opens no interface

@@ -129,7 +129,7 @@ TEST(FarField, LongRodElementsTakeTheWeakestOfTheirParts) {
 // -0.7%, U_c +0.3%) and theta_D = 30 with a node every 2 slices (load +0.9%, J +1.2%, U_c -0.9%). At
 // theta_D = 30 every 4 slices is 4-5% too stiff (load +4.2%, J +4.9%, U_c -3.4%; every 8: +15%): the rods of
 // the two plies cross every ~1 d along x and bend between the crossings, which a rod element longer than
-// that cannot follow (README, Reduced far field).
+// that cannot follow (docs/solver.md, Reduced far field).
 TEST(FarField, ElasticResponseMatchesTheFullModel) {
   for (auto [theta, slices] : {std::pair{0, 4}, std::pair{30, 2}}) {
     const std::string angle = "theta_D = " + std::to_string(theta) + "\n";

@@ -1,4 +1,4 @@
-// Crossply geometry (DESIGN section 2): Voronoi connectivity, edge lengths, crisscross spacing, periodic
+// Crossply geometry (docs/model.md): Voronoi connectivity, edge lengths, crisscross spacing, periodic
 // wrap, pre-crack and hand counts.
 #include <gtest/gtest.h>
 

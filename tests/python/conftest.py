@@ -1,5 +1,5 @@
 """Shared fixtures: the solver binary (ENAMEL_BINARY, set by `make test`), the small test cases, and the runs
-that several modules read, each made once per session (ci_run, tiny_run)."""
+that several modules read, each made once per pytest run (ci_run, tiny_run)."""
 import os
 import pathlib
 import signal
@@ -32,7 +32,7 @@ def run(enamel):
     return _run
 
 
-class SessionRuns:
+class SharedRuns:
     """Runs of paper cases at the ci preset (with `sets` on top), each made the first time a test asks for it and
     shared by every module after: runs(case) -> ROOT_DIR/ci/<case>/result.h5 (the layout of runs/, so figure
     scripts read them with --runs ROOT_DIR --preset ci)."""
@@ -54,16 +54,16 @@ class SessionRuns:
 
 @pytest.fixture(scope="session")
 def ci_run(run, tmp_path_factory):
-    """ci_run(case): the paper case at the ci preset, run once per session (the reference, reference-solver and
+    """ci_run(case): the paper case at the ci preset, run once per pytest run (the reference, reference-solver and
     hard-case tests share theta0_s21.4_e10_cv0 and theta30_s21.4_e10_cv0)."""
-    return SessionRuns(run, tmp_path_factory.mktemp("ci_runs"), [])
+    return SharedRuns(run, tmp_path_factory.mktemp("ci_runs"), [])
 
 
 @pytest.fixture(scope="session")
 def tiny_run(run, tmp_path_factory):
-    """tiny_run(case): the paper case at the tiny ci variant TINY_SETS, run once per session (figures and VTK
+    """tiny_run(case): the paper case at the tiny ci variant TINY_SETS, run once per pytest run (figures and VTK
     export tests); tiny_run.root is the runs/ root of all of them."""
-    return SessionRuns(run, tmp_path_factory.mktemp("tiny_runs"), TINY_SETS)
+    return SharedRuns(run, tmp_path_factory.mktemp("tiny_runs"), TINY_SETS)
 
 
 def checkpoint_stamp(out):

@@ -1,4 +1,4 @@
-"""The bench script itself (issue "Speed against error"), in its --quick mode (tiny specimens at the ci preset):
+"""The bench script itself, in its --quick mode (tiny specimens at the ci preset):
 it runs, writes results.csv, cost_growth.csv, results.md and both figures, measures the reference against
 itself as zero error, and computes the errors of the other variants against it. Correctness only: no
 timing is asserted here (`make bench` measures). Also `make bench-paper`'s script (bench/paper_preset.py):
@@ -14,6 +14,7 @@ import time
 import h5py
 
 from conftest import ROOT
+from enamel_results.constants import EXIT
 
 
 
@@ -78,11 +79,11 @@ def test_profile_times_every_kernel_and_refuses_the_paper_scheme(enamel):
     assert all(t >= 0 for t in rows.values()) and rows["step"] > 0 and rows["interfaces"] > 0
     assert rows["nodes"] + rows["interfaces"] + rows["positions"] >= rows["advance"] * (1 - 1e-3)  # printed to 4 digits
     r = subprocess.run(args + ["--set", 'integrator="paper"'], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 7 and "integrator 'paper' is not profiled (allowed: lumped)" in r.stderr
+    assert r.returncode == EXIT["out_of_range"] and "integrator 'paper' is not profiled (allowed: lumped)" in r.stderr
 
 
 def start_paper_preset(enamel, tmp_path):
-    """bench/paper_preset.py --quick on a run long enough to interrupt, started in its own session (as a
+    """bench/paper_preset.py --quick on a run long enough to interrupt, started in a process group of its own (as a
     terminal's process group); returns once the solver has written its first partial result."""
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
     cmd = [sys.executable, "-m", "bench.paper_preset", "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
@@ -103,7 +104,7 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     p, cmd, env, run = start_paper_preset(enamel, tmp_path)
     os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=120)
-    assert p.returncode == 12, (p.returncode, err)   # the solver's "interrupted"
+    assert p.returncode == EXIT["interrupted"], (p.returncode, err)   # the solver's "interrupted"
     assert (run / "checkpoint.bin").exists()
     md = (tmp_path / "paper_preset.md").read_text()
     assert "status: **interrupted**" in md and "not finished" in md
@@ -131,7 +132,7 @@ def test_paper_preset_passes_sigterm_on_to_the_solver(enamel, tmp_path):
     p, _, _, run = start_paper_preset(enamel, tmp_path)
     p.send_signal(signal.SIGTERM)
     out, err = p.communicate(timeout=120)
-    assert p.returncode == 12, (p.returncode, err)
+    assert p.returncode == EXIT["interrupted"], (p.returncode, err)
     assert (run / "checkpoint.bin").exists() and "interrupted by signal 15" in (run / "log.txt").read_text()
 
 

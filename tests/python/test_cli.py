@@ -8,9 +8,12 @@ import h5py
 import pytest
 
 from conftest import CASES
+from enamel_results.constants import EXIT
 
-# Exit statuses (solver/lib/exit_codes.hpp).
-USAGE, MISSING_FILE, MALFORMED, UNKNOWN_KEY, WRONG_TYPE, OUT_OF_RANGE, UNWRITABLE, EXISTS = 2, 3, 4, 5, 6, 7, 8, 9
+# Exit statuses, read from solver/lib/exit_codes.hpp (enamel_results.constants).
+USAGE, MISSING_FILE, MALFORMED, UNKNOWN_KEY, WRONG_TYPE, OUT_OF_RANGE, UNWRITABLE, EXISTS = (
+    EXIT[k] for k in ("usage", "missing_file", "malformed_toml", "unknown_key", "wrong_type", "out_of_range",
+                      "output_unwritable", "output_exists"))
 
 GOOD = "theta_D = 0\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n"
 
@@ -143,7 +146,7 @@ def test_diverging_run_stops_with_readable_failed_result(enamel, tmp_path):
     env = dict(os.environ, ENAMEL_INJECT_NAN_AT_STEP="200")
     r = subprocess.run([str(enamel), "run", str(CASES / "small_theta0.toml"), "--out", str(out), "--quiet"],
                        capture_output=True, text=True, env=env, timeout=600)
-    assert r.returncode == 10, r.stderr
+    assert r.returncode == EXIT["run_unstable"], r.stderr
     assert "non-finite" in r.stderr and "step" in r.stderr
     assert not (out / "result.h5").exists() and not (out / "result.partial.h5").exists()
     with h5py.File(out / "result.failed.h5", "r") as f:

@@ -1,4 +1,4 @@
-"""The reduced far field (case keys far_field_slices, full_half_height_over_d; README "Reduced far field") through
+"""The reduced far field (case keys far_field_slices, full_half_height_over_d; docs/solver.md, "Reduced far field") through
 the command line: a band wider than the specimen gives the full model's run bit for bit; a run whose inelastic
 zone comes within 2 d of the band's edge stops with a message saying so and keeps what it wrote; a far field
 without its band is refused before anything is written. The elastic response against the full model is the C++
@@ -7,6 +7,7 @@ import h5py
 import numpy as np
 
 from conftest import PAPER_CASES, run_with_kills
+from enamel_results.constants import EXIT
 
 CASE = "theta30_s21.4_e10_cv0"
 
@@ -50,7 +51,7 @@ def test_theta0_with_a_far_field_gives_four_thirds_and_restarts_bit_for_bit(run,
 def test_inelastic_zone_at_the_band_edge_stops_the_run(run, tmp_path):
     out = tmp_path / "edge"
     r = run_ci(run, out, "far_field_slices=2", "full_half_height_over_d=2.5")
-    assert r.returncode == 10, r.stderr
+    assert r.returncode == EXIT["run_unstable"], r.stderr
     assert "edge of the full band" in r.stderr and "full_half_height_over_d = 2.5" in r.stderr
     with h5py.File(out / "result.failed.h5", "r") as f:
         assert f["meta"].attrs["status"] == "failed"
@@ -67,9 +68,9 @@ def test_far_field_rod_breaks_allowed_are_recorded_and_interfaces_still_stop(run
     sets = ["sigma_ru_over_sigma0=8", "cv=0.5", "far_field_slices=2", "full_half_height_over_d=3.5"]
     stop, allow = tmp_path / "stop", tmp_path / "allow"
     r = run_ci(run, stop, *sets)
-    assert r.returncode == 10 and "inelastic zone reached" in r.stderr, r.stderr
+    assert r.returncode == EXIT["run_unstable"] and "inelastic zone reached" in r.stderr, r.stderr
     r = run_ci(run, allow, *sets, 'far_field_rod_breaks="allow"')
-    assert r.returncode == 10 and "interfaces past delta0 reached" in r.stderr, r.stderr
+    assert r.returncode == EXIT["run_unstable"] and "interfaces past delta0 reached" in r.stderr, r.stderr
     with h5py.File(stop / "result.failed.h5", "r") as fs, h5py.File(allow / "result.failed.h5", "r") as fa:
         assert "a rod element broke" not in fs["meta"].attrs["warnings"]
         assert "a rod element broke" in fa["meta"].attrs["warnings"] and "far_field_rod_breaks = allow" in fa["meta"].attrs["warnings"]
@@ -82,7 +83,7 @@ def test_far_field_rod_breaks_allowed_are_recorded_and_interfaces_still_stop(run
 def test_far_field_without_its_band_is_refused(run, tmp_path):
     out = tmp_path / "bad"
     r = run_ci(run, out, "far_field_slices=4")
-    assert r.returncode == 7
+    assert r.returncode == EXIT["out_of_range"]
     assert "'full_half_height_over_d' = 0" in r.stderr and "[1, 1000]" in r.stderr
     assert not out.exists()
 

@@ -1,9 +1,9 @@
-"""Figure scripts and summary table (issue "Pipeline and figures"): each script runs on result files and writes
+"""Figure scripts and summary table: each script runs on result files and writes
 a non-empty PDF and PNG, a missing result file is one clear line and a non-zero exit, the summary table has one
 row per case with our HDF5 attributes copied exactly, and each number of paper_values.toml is what its quote says.
 
 The result files come from tiny runs (8 d x 4 d specimen, stopped at Delta_a/d = 1.5, ~2 s each) made once per
-session (conftest.tiny_run) in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/.
+pytest run (conftest.tiny_run) in a temporary runs/ci/ tree, so the tests do not depend on what is in runs/.
 Scripts run in this process (runpy, as `python3 -m figures.<script>` runs them) to keep the tests fast; one
 missing-file test runs a script as a subprocess for the real exit status.
 """
@@ -25,6 +25,7 @@ import h5py
 import numpy as np
 import pytest
 
+from enamel_results import cases
 from enamel_results.cases import params_from_name
 from enamel_results.metrics import pooled_rm
 from enamel_results.results import EXIT_MISSING, load_result
@@ -33,8 +34,8 @@ from figures import plotting, summary_table
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIGURES = ROOT / "figures"
 PYTHON = sys.executable
-MAP_SCRIPTS = ["fig4_decussation", "fig5_rod_strength", "fig6_stiffness_contrast", "fig8_statistics_rcurves"]
-SCRIPTS = MAP_SCRIPTS + ["fig7_summary", "fig9_statistics_mean", "summary_table"]
+# Every figure script figures/figN_<name>.py with its table figN_<name>.toml, as the Makefile finds them.
+SCRIPTS = list(cases.figure_scripts().values()) + ["summary_table"]
 # Tiny runs: one case of Figs. 4/5/6/7 and one of Figs. 8/9 (it breaks rods).
 TINY_CASES = ["theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1"]
 ATTR_RTOL = 1e-9  # CSV values are written with 10 significant digits
@@ -168,6 +169,46 @@ def test_missing_result_exit_status_in_a_subprocess(tmp_path):
     assert len(r.stderr.strip().splitlines()) == 1 and "make runs PRESET=ci" in r.stderr
 
 
+# ------------------------------------------------------------------------------------------ a new figure
+NEW_FIGURE = '''"""Fig. 99 (test only): the R-curves of its table's cases."""
+import sys
+
+from enamel_results import cli
+
+
+def main(argv=None):
+    print("fig99 drawn")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+'''
+
+
+def test_a_new_figure_script_is_discovered(tmp_path):
+    """A new figure is one script and its table next to it: copied beside the real ones into a figures folder
+    of its own, a test-only fig99_test.py + fig99_test.toml joins the figure list, the scripts the tests run,
+    and the Make variables (pipeline.make_rules) without any list being edited; without its table it is an
+    error naming the missing file."""
+    figs = tmp_path / "figures"
+    shutil.copytree(FIGURES, figs, ignore=shutil.ignore_patterns("out", "__pycache__"))
+    (figs / "fig99_test.py").write_text(NEW_FIGURE)
+    with pytest.raises(FileNotFoundError, match="fig99_test.toml"):
+        cases.figure_list(figs)
+    (figs / "fig99_test.toml").write_text('cases = ["theta0_s21.4_e10_cv0"]\nslow = ["theta0_s21.4_e10_cv0"]\n')
+    assert cases.figure_scripts(figs)["fig99"] == "fig99_test"
+    assert list(cases.figure_list(figs)) == [*cases.figure_list(), "fig99"]
+    assert cases.figure_list(figs)["fig99"]["cases"] == ["theta0_s21.4_e10_cv0"]
+    mk = tmp_path / "figures.mk"
+    from pipeline import make_rules
+    make_rules.main([str(mk), "--figures-dir", str(figs)])
+    text = mk.read_text()
+    assert "FIG99_CASES := theta0_s21.4_e10_cv0" in text and "FIG99_SLOW := theta0_s21.4_e10_cv0" in text
+    assert re.search(r"^FIGURES := fig4 fig5 fig6 fig7 fig8 fig9 fig99$", text, re.M)
+    assert re.search(r"^ALL_SLOW := .*theta0_s21.4_e10_cv0", text, re.M)
+
+
 # fig5 and fig6 are fig4's code (plotting.map_figure) with other cases: --help and the missing-file test cover them.
 @pytest.mark.parametrize("script", ["fig4_decussation", "fig8_statistics_rcurves", "fig7_summary",
                                     "fig9_statistics_mean"])
@@ -190,7 +231,7 @@ def test_summary_table_rows_columns_and_values(tiny_runs, tmp_path):
         reader = csv.DictReader(f)
         assert list(reader.fieldnames) == list(summary_table.COLUMNS)
         rows = list(reader)
-    figs = tomllib.loads((ROOT / "paper_cases" / "figures.toml").read_text())
+    figs = cases.figure_list()
     unique = {c for e in figs.values() for c in e["cases"]}
     base = [row for row in rows if row["loading"] == "preset"]
     assert sorted(row["case"] for row in base) == sorted(unique), "one row per case of every figure"

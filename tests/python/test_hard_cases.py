@@ -1,7 +1,7 @@
-"""Hard cases (issue "Hard cases and faults"): each runs at the ci preset to its stop criterion and must finish
+"""Hard cases: each runs at the ci preset to its stop criterion and must finish
 with status "completed", no NaN/Inf anywhere in /history or /rcurve, and an energy-balance error within
 BALANCE_BOUND once the external work is meaningful (> 1% of its final value, as in test_reference_solver).
-theta_D = 0 is the session's shared ci run of paper_cases/theta0_s21.4_e10_cv0.toml (conftest.ci_run, to the
+theta_D = 0 is the shared ci run of paper_cases/theta0_s21.4_e10_cv0.toml (conftest.ci_run, to the
 preset's Delta_a = 5 d); the others are the theta_D = 30 base case with their changes, to Delta_a = 4 d."""
 import h5py
 import numpy as np
@@ -23,7 +23,7 @@ HARD = {
     "theta0": None,  # the shared ci run of THETA0_CASE
     "theta45": ["theta_D=45"],
     # rods so weak that many elements pass their strength in the same step (deletion rule "all") and nodes
-    # lose every rod element around them (they keep their lumped mass: DESIGN section 3 departure)
+    # lose every rod element around them (they keep their lumped mass: docs/model.md departure)
     VERY_WEAK: ["sigma_ru_over_sigma0=0.6", "deletion_rule=\"all\""],
 }
 

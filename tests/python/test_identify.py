@@ -1,5 +1,5 @@
-"""The identification study's report (studies/identify/identify.py, issue 17) regenerates from its committed data
-alone: runs/ does not survive a session, so every run's metrics and R-curve are kept in studies/identify/data/
+"""The identification study's report (studies/identify/identify.py) regenerates from its committed data
+alone: runs/ does not survive the machine it ran on, so every run's metrics and R-curve are kept in studies/identify/data/
 (README "Changes to the plan" 6) and the report must give the same rows and convergence numbers from them, with
 no run folder at all. A store/load round trip on a tiny solver run checks that a run folder's row and its
 committed record agree (metrics, curve to the stored digits, L2 between two runs)."""

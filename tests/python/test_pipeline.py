@@ -1,4 +1,4 @@
-"""The pipeline survives being killed (issue "Ecosystem and robustness"): after SIGKILL of make's whole process
+"""The pipeline survives being killed: after SIGKILL of make's whole process
 group in the middle of a run, there is no result.h5 (so nothing counts the unfinished run as done), and the next
 `make` continues that run from its checkpoint to the same result, bit for bit, as an uninterrupted run."""
 import os

@@ -1,7 +1,7 @@
-"""Reference outputs (issue "Pipeline and figures"): re-run the reference cases at the ci preset and compare
+"""Reference outputs: re-run the reference cases at the ci preset and compare
 R-curves and failure counts with tests/reference/<case>.json within the tolerances stored there
 (tests/reference/make_reference.py states why each is what it is; `make reference` regenerates them).
-The runs are the session's shared ci runs (conftest.ci_run), made as make_reference.run_case makes them."""
+The runs are the shared ci runs (conftest.ci_run), made as make_reference.run_case makes them."""
 import json
 
 import pytest

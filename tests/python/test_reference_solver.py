@@ -1,7 +1,7 @@
-"""Reference-solver checks that run the binary at the `ci` preset (and one at `reduced`; issue "Reference solver"):
+"""Reference-solver checks that run the binary at the `ci` preset (and one at `reduced`):
 theta_D = 0 gives R = 4/3 Gamma_i, half the loading rate gives the same R-curve, theta_D = 30 runs to its
 stop criterion with broken rods and a rising R-curve, and result.h5 has the documented layout.
-The theta_D = 0 and 30 runs are the session's shared ci runs (conftest.ci_run)."""
+The theta_D = 0 and 30 runs are the shared ci runs (conftest.ci_run)."""
 import h5py
 import numpy as np
 import pytest

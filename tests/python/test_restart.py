@@ -1,4 +1,4 @@
-"""Checkpoint and restart (issue "Hard cases and faults"): a run killed with SIGKILL at arbitrary moments and
+"""Checkpoint and restart: a run killed with SIGKILL at arbitrary moments and
 restarted with --restart each time gives the same result as an uninterrupted run, bit for bit (same thread
 count); SIGINT writes a checkpoint and a readable partial result marked "interrupted"; a bad checkpoint is
 refused with its own exit status."""
@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT, checkpoint_stamp, run_with_kills
+from enamel_results.constants import EXIT
 
 CASE = ROOT / "paper_cases" / "theta30_s7.1_e10_cv0.toml"   # rods and interfaces break: deletions replay
 # a small, fast variant of the ci preset (about 2 s); the kill test checkpoints every 0.1 s of wall time
@@ -117,7 +118,7 @@ def test_resume_continues_only_this_builds_checkpoint(enamel, uninterrupted, tmp
 def test_bad_checkpoints_are_refused(run, tmp_path):
     out = tmp_path / "bad"
     r = run(*args_for(out, "--restart"))
-    assert r.returncode == 3 and "no checkpoint" in r.stderr, r.stderr
+    assert r.returncode == EXIT["missing_file"] and "no checkpoint" in r.stderr, r.stderr
     out.mkdir(exist_ok=True)
     (out / "checkpoint.bin").write_bytes(b"ENAMELCK\x01\x00\x00\x00garbage")
     r = run(*args_for(out, "--restart"))

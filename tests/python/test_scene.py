@@ -1,4 +1,4 @@
-"""The scene measurement (studies/scene/measure_scene.py, issue "Model only what a scene needs", item 1) on a
+"""The scene measurement (studies/scene/measure_scene.py) on a
 ci run of theta30 (21.4, 10): its bands are measured from the crack plane and path of that run, lie within the
 specimen, grow as the crack does, and agree with a direct count from the frame; the nearest-distance helper
 against a brute-force check."""

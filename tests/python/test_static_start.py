@@ -1,4 +1,4 @@
-"""Static elastic start (case key static_start, issue 15 item 2b): the run starts from the static elastic solution at
+"""Static elastic start (case key static_start): the run starts from the static elastic solution at
 a fraction of the first-damage displacement U_c instead of loading the specimen from rest. Its first history row
 is that state (elastic, in energy balance, nearly at rest relative to its strain energy); the R-curve agrees with
 the run from rest; /meta records what was done; a checkpointed run with it restarts bit for bit; a case with

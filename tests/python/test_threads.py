@@ -1,4 +1,4 @@
-"""Multithreading (issue "Speed against error"): the force loops run in parallel with OpenMP, and a run with
+"""Multithreading: the force loops run in parallel with OpenMP, and a run with
 2 threads gives the same result as with 1 thread, bit for bit: R-curve, the whole /history (energies,
 J, counts) and the final damage state. Both integrators; a small case in which rods and interfaces break."""
 import h5py

@@ -1,4 +1,4 @@
-"""The issue "Performance" check at 100 x 100 d: `make bench-paper`'s variant (lumped, dt_factor 0.22,
+"""The check at 100 x 100 d: `make bench-paper`'s variant (lumped, dt_factor 0.22,
 damping_cap 0.5, static_start 0.95) against the same scheme from rest (the unaccelerated lumped run), theta_D = 30
 (21.4, 10), to Delta_a = 30 d.
 
@@ -19,8 +19,9 @@ import sys
 
 import numpy as np
 
-from bench.run_bench import history_end
-from enamel_results import metrics, results
+from enamel_results import metrics
+from enamel_results import records as run_records
+from enamel_results.records import R_at
 
 HERE = pathlib.Path(__file__).resolve().parent
 NAMES = ("rest", "static")
@@ -36,29 +37,7 @@ def result_file(run_dir: pathlib.Path) -> pathlib.Path:
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
-    r = results.load_result(result_file(run_dir))  # the case from /meta's case_source
-    m = r.meta
-    keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt",
-            "max_kinetic_over_strain_while_growing", "peak_memory_mb", "git_hash", "static_start")
-    meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
-    meta.update(history_end(result_file(run_dir)))
-    import h5py
-    with h5py.File(result_file(run_dir), "r") as f:  # the scene (issue 16): reach against Delta_a
-        h = f["history"]
-        da_h, reach, step_h = np.asarray(h["da_over_d"]), np.asarray(h["inelastic_reach_over_d"]), np.asarray(h["step"])
-    scene = [(float(d), float(reach[np.argmax(da_h >= d)])) for d in (0.0, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
-    # the step at which the crack first reached each Delta_a (0: its start), for the steps saved at equal advance
-    steps_at = [(float(d), int(step_h[np.argmax(da_h >= d)])) for d in (1e-9, 1, 2, 5, 10, 15, 20, 25, 30) if (da_h >= d).any()]
-    return dict(name=name, case=r.case, meta=meta,
-                R_init=r.R_init, R_ss=r.R_ss, R_m=r.R_m, da_max=r.da_max, broken_rods=r.broken_rods,
-                warnings=str(m.get("warnings", "")), reach_at_da=scene, steps_at_da=steps_at,
-                da=[float(f"{x:.10g}") for x in r.da], R=[float(f"{x:.10g}") for x in r.R])
-
-
-def R_at(rec: dict, d: float) -> float:
-    """R/Gamma at the first R-curve point at or past Delta_a = d (nan when the crack did not get there)."""
-    da, R = np.array(rec["da"]), np.array(rec["R"])
-    return float(R[np.argmax(da >= d)]) if (da >= d).any() else math.nan
+    return run_records.record_of(result_file(run_dir), name)
 
 
 def report(records: dict) -> str:

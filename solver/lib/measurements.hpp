@@ -1,0 +1,45 @@
+#pragma once
+// The measurements of a run, as free functions over its plain data (state.hpp): J at the outer boundary, the
+// crack advance, the energies, the counts of failed and inelastic interfaces, how far the inelastic zone
+// reaches. None changes anything; Simulation::measure gathers them into one /history row. docs/model.md
+// (Loading, damping, measurements) states each.
+#include "state.hpp"
+
+namespace enamel {
+
+/// 1/2 q^T K q: the strain energy of the intact rod elements.
+double strainEnergyOfBeams(const Operators& ops, const State& s);
+/// Strain energy the interfaces hold (summed in a fixed order: independent of the thread count).
+double strainEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const State& s);
+/// Energy the interfaces dissipated (their damage: Gamma_i per area once failed).
+double fractureEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const State& s);
+int countFailedInterfaces(const cohesive::Law& law, const State& s);     // separation past delta_f
+int countInelasticInterfaces(const cohesive::Law& law, const State& s);  // separation past delta0
+
+/// How far from the crack plane (|y - y_crack|, at the midpoint of the element's nodes' reference positions)
+/// the interfaces past delta0 reach, the deleted rod elements reach, and the larger of the two (0 while
+/// everything is elastic).
+double inelasticInterfaceReach(const Model& m, const cohesive::Law& law, const State& s);
+double brokenRodReach(const Model& m, const State& s);
+double inelasticReach(const Model& m, const cohesive::Law& law, const State& s);
+
+/// The loaded faces' term of J before the 1/B: sum over the prescribed DOFs of F_y du_y/dx, with F_y the
+/// force the grip applies and du_y/dx = ops.prescribedSlope x U / w_s (-U/w_s on the top row, +U/w_s on the
+/// bottom row, also at x = w_s where the shape value is +/-0).
+double sumGripForceTimesSlope(const Model& m, const Operators& ops, const State& s);
+/// Strain energy per unit length in x at a free face: side 0 the left face (the elements starting in slice
+/// `slice`), side 1 the right face (those ending there). Rod elements of the first segment over h_e,
+/// interfaces of the end slice over their tributary h_e / 2; in a reduced far field an element spanning n
+/// slices over n h_e and an interface over the length along x it stands for (area / edge length).
+double faceEnergyDensity(const Model& m, const Materials& mat, const State& s, int slice, int side);
+/// J at the outer boundary, per unit thickness B: J = (1/B) [ -sum F_y du_y/dx + W_right - W_left ].
+double computeJ(const Model& m, const Materials& mat, const Operators& ops, const State& s);
+
+/// Delta_a: the connected cluster of failed interfaces and deleted rod elements that touches the pre-crack,
+/// max x over it - a0 (projected on x; daughter cracks count once they join).
+double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State& s);
+
+/// The generalised force conjugate to U: sum of F_y x shape over the prescribed DOFs.
+double computeGripLoad(const Operators& ops, const State& s);
+
+}  // namespace enamel

@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+"""The include layers of solver/lib (docs/contributing.md): each file may include only files of its own layer or
+a lower one. Reads every `#include "..."` line of solver/lib/*.{hpp,cpp} and solver/app/*.cpp; prints each
+include that goes up a layer (and each file missing from the table) and exits 1 if there is any, else prints
+how many includes it checked and exits 0. Standard library only: `python3 tools/check_layers.py`."""
+from __future__ import annotations
+
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+# Lowest first. A file's layer is that of its stem (foo.hpp and foo.cpp share one).
+LAYERS = [
+    ("base", ["version", "exit_codes", "errors", "git_hash"]),
+    ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params", "resources"]),
+    ("geometry", ["geometry", "far_field"]),
+    ("plain data", ["state"]),
+    ("loops over the data", ["kernels", "node_blocks", "loading_rate", "measurements", "static_solve"]),
+    ("schemes and set-up", ["integrators", "setup"]),
+    ("the simulation", ["simulation"]),
+    ("files and tools", ["output", "checkpoint", "profile"]),
+    ("the run", ["runner"]),
+    ("the command line", ["enamel_dem"]),
+]
+LAYER_OF = {stem: i for i, (_, stems) in enumerate(LAYERS) for stem in stems}
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+
+
+def sources(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
+    return sorted([*root.glob("solver/lib/*.hpp"), *root.glob("solver/lib/*.cpp"), *root.glob("solver/app/*.cpp")])
+
+
+def violations(files: list[pathlib.Path]) -> tuple[list[str], int]:
+    """(messages, number of includes checked)."""
+    out, checked = [], 0
+    for f in files:
+        if f.stem not in LAYER_OF:
+            out.append(f"{f.name}: not in the layer table of tools/check_layers.py")
+            continue
+        mine = LAYER_OF[f.stem]
+        for n, line in enumerate(f.read_text(errors="replace").splitlines(), 1):
+            m = INCLUDE.match(line)
+            if not m:
+                continue
+            checked += 1
+            stem = pathlib.Path(m[1]).stem
+            if stem not in LAYER_OF:
+                out.append(f"{f.name}:{n}: includes {m[1]}, which is not in the layer table")
+            elif LAYER_OF[stem] > mine:
+                out.append(f"{f.name}:{n}: includes {m[1]} (layer {LAYER_OF[stem]} {LAYERS[LAYER_OF[stem]][0]!r}) "
+                           f"from layer {mine} {LAYERS[mine][0]!r}: an include from a lower layer to a higher one")
+    return out, checked
+
+
+def main(argv: list[str]) -> int:
+    files = [pathlib.Path(a) for a in argv] or sources()
+    bad, checked = violations(files)
+    for b in bad:
+        print(b)
+    if bad:
+        return 1
+    print(f"check_layers: {checked} includes in {len(files)} files, none from a lower layer to a higher one")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
