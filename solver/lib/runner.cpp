@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "exit_codes.hpp"
+#include "file_io.hpp"
 #include "loading_rate.hpp"
 
 namespace enamel {
@@ -62,7 +63,10 @@ void requestStop(int signal) { gStopSignal = signal; }
 
 int exitCodeOf(const std::exception& e) {
   if (const auto* c = dynamic_cast<const CaseError*>(&e)) return c->exitCode;
+  if (dynamic_cast<const CheckpointDamaged*>(&e)) return exit_code::checkpoint_damaged;
   if (dynamic_cast<const CheckpointError*>(&e)) return exit_code::checkpoint_invalid;
+  if (const auto* w = dynamic_cast<const WriteError*>(&e))
+    return w->diskFull ? exit_code::disk_full : exit_code::output_unwritable;
   if (dynamic_cast<const IntegratorError*>(&e) || dynamic_cast<const std::invalid_argument*>(&e))
     return exit_code::out_of_range;
   return exit_code::run_failed;

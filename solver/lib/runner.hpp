@@ -51,9 +51,9 @@ struct StopTargets {
 /// since the displacement limit is usually a far safety net.
 double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop);
 
-/// The exit status (exit_codes.hpp) for an error that ended a command: a bad case (its CaseError's code), a bad
-/// checkpoint 13, a case the integrator refuses or a value out of range 7, anything else (a factorisation
-/// that failed, a file that cannot be written) 11.
+/// The exit status (exit_codes.hpp) for an error that ended a command: a bad case (its CaseError's code), a
+/// checkpoint of another build or case 13, a damaged one 14, a full disk 15, a file that cannot be written 8, a
+/// case the integrator refuses or a value out of range 7, anything else (a factorisation that failed) 11.
 int exitCodeOf(const std::exception& e);
 
 /// Ask a running simulation to stop at the next step (signal handlers call this).
