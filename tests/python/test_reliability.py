@@ -9,7 +9,9 @@ import shutil
 import signal
 import subprocess
 import time
+import struct
 import types
+import zlib
 
 import pytest
 
@@ -231,3 +233,46 @@ def test_resume_continues_across_result_neutral_keys_only(enamel, tmp_path):
         r = subprocess.run([str(enamel), *args_for(out, "--resume", "--force", sets=SETS + [changed])],
                            capture_output=True, text=True, timeout=300)
         assert "starting from step 0" in r.stderr and "different case" in r.stderr, f"{changed}: {r.stderr}"
+
+
+# --- the blow-up guard -----------------------------------------------------------------------------------------
+
+def state_vectors(data: bytes) -> dict:
+    """{name: (offset of the first value, count)} of the checkpoint's state vectors (checkpoint.cpp transferFields:
+    magic, version, build, case, 7 scalars, then q, v, a, vHalf; the lumped scheme of the ci preset steps vHalf)."""
+    at = 8 + 4
+    for _ in range(2):  # build fingerprint, case TOML
+        (n,) = struct.unpack_from("<Q", data, at)
+        at += 8 + n
+    at += 7 * 8
+    out = {}
+    for name in ("q", "v", "a", "vHalf"):
+        (n,) = struct.unpack_from("<Q", data, at)
+        out[name] = (at + 8, n)
+        at += 8 + 8 * n
+    return out
+
+
+def reseal_checkpoint(data: bytes) -> bytes:
+    """The checkpoint with its CRC-32 recomputed: a state damaged before it was written (memory, a bug), which
+    the checksum cannot see and the guard must."""
+    body = data[:-12]
+    return body + struct.pack("<I", zlib.crc32(body)) + data[-8:]
+
+
+@pytest.mark.parametrize("name, value", [("q", 1e30), ("vHalf", 1e100), ("vHalf", -1e50), ("q", float("nan"))])
+def test_a_blown_up_state_fails_the_guard(enamel, checkpoint, tmp_path, name, value):
+    data = bytearray(checkpoint.read_bytes())
+    first, n = state_vectors(bytes(data))[name]
+    for i in range(n // 2, n // 2 + 4):
+        struct.pack_into("<d", data, first + 8 * i, value)
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "checkpoint.bin").write_bytes(reseal_checkpoint(bytes(data)))
+    r = subprocess.run([str(enamel), *args_for(out, "--resume")], capture_output=True, text=True, timeout=300)
+    assert "resuming from checkpoint" in r.stderr, r.stderr
+    assert r.returncode == EXIT["run_unstable"], f"exit {r.returncode}: {r.stderr}"
+    assert not (out / "result.h5").exists() and (out / "result.failed.h5").exists()
+    assert results.load_result(out / "result.failed.h5").status == "failed"
+    assert any(w in r.stderr for w in ("energy balance error", "non-finite state", "kinetic / strain energy",
+                                       "negative beyond round-off")), r.stderr
