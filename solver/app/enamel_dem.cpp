@@ -168,8 +168,7 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   if (int rc = prepareOutput(outDir, flags.force || restart, resultPath)) return rc;
   removeStaleResults(outDir);
   Simulation sim(p);
-  std::signal(SIGINT, requestStop);
-  std::signal(SIGTERM, requestStop);
+  installStopHandlers();
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit (ulimit -f) fails the write (EFBIG), it does not kill the run
   if (!flags.quiet)
     std::fprintf(stderr, "enamel-dem: %s: %d DOF, %d interfaces, dt %.3g, integrator %s -> %s\n",

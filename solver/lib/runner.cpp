@@ -1,6 +1,9 @@
 #include "runner.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <chrono>
@@ -59,6 +62,68 @@ double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& no
 }
 
 void requestStop(int signal) { gStopSignal = signal; }
+
+namespace {
+
+// Async-signal-safe pieces of the signal log line: only write(2), open(2), read(2), close(2).
+void put(char*& at, const char* end, const char* text) {
+  while (*text && at < end) *at++ = *text++;
+}
+void putNumber(char*& at, const char* end, long value) {
+  char digits[24];
+  int n = 0;
+  unsigned long v = value < 0 ? 0UL - static_cast<unsigned long>(value) : static_cast<unsigned long>(value);
+  do digits[n++] = static_cast<char>('0' + v % 10); while ((v /= 10) && n < 23);
+  if (value < 0 && at < end) *at++ = '-';
+  while (n > 0 && at < end) *at++ = digits[--n];
+}
+
+// SIGINT/SIGTERM: stop at the next step (requestStop), and say on stderr who sent it (pid, uid, its command
+// name from /proc), so that a run ended on a cluster node can tell SLURM, make or a user apart.
+void onStopSignal(int signal, siginfo_t* info, void*) {
+  const int savedErrno = errno;
+  requestStop(signal);
+  char line[256];
+  char* at = line;
+  const char* end = line + sizeof line - 1;
+  put(at, end, "enamel-dem: received signal ");
+  putNumber(at, end, signal);
+  put(at, end, " from pid ");
+  putNumber(at, end, info ? info->si_pid : -1);
+  put(at, end, " (uid ");
+  putNumber(at, end, info ? static_cast<long>(info->si_uid) : -1);
+  if (info && info->si_pid > 0) {
+    char path[40] = "/proc/";
+    char* p = path + 6;
+    putNumber(p, path + sizeof path - 6, info->si_pid);
+    put(p, path + sizeof path - 1, "/comm");
+    *p = '\0';
+    const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+    if (fd >= 0) {
+      char comm[32];
+      const ssize_t n = ::read(fd, comm, sizeof comm - 1);
+      ::close(fd);
+      if (n > 0) {
+        put(at, end, ", ");
+        for (ssize_t i = 0; i < n && comm[i] != '\n' && at < end; ++i) *at++ = comm[i];
+      }
+    }
+  }
+  put(at, end, "): stopping at the next step with a checkpoint\n");
+  ssize_t ignored = ::write(STDERR_FILENO, line, static_cast<std::size_t>(at - line));
+  (void)ignored;
+  errno = savedErrno;
+}
+
+}  // namespace
+
+void installStopHandlers() {
+  struct sigaction sa = {};
+  sa.sa_sigaction = onStopSignal;
+  sa.sa_flags = SA_SIGINFO | SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  for (int s : {SIGINT, SIGTERM}) sigaction(s, &sa, nullptr);
+}
 
 GuardBounds guardBounds(double Gamma, double B) {
   GuardBounds b;

@@ -81,4 +81,8 @@ std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBo
 /// Ask a running simulation to stop at the next step (signal handlers call this).
 void requestStop(int signal);
 
+/// SIGINT and SIGTERM call requestStop, and each writes one line on stderr naming the signal and its sender
+/// (pid, uid, command name: SA_SIGINFO).
+void installStopHandlers();
+
 }  // namespace enamel
