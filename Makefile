@@ -43,7 +43,8 @@ RUN_SET ?=
 # libopenblas0-pthread: CHOLMOD's supernodal factorisation calls BLAS; OpenBLAS replaces the reference BLAS
 # through Debian's alternatives (the static elastic start of a paper-size case: minutes instead of ~8 min).
 DEB_PACKAGES := g++ make cmake pkg-config git \
-  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libhdf5-dev libtomlplusplus-dev libcli11-dev libgtest-dev \
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libhdf5-dev zlib1g-dev libtomlplusplus-dev libcli11-dev \
+  libgtest-dev \
   python3 python3-numpy python3-h5py python3-matplotlib python3-meshio python3-pytest python3-vtk9 \
   slurm-wlm munge valgrind
 

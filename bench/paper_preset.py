@@ -61,8 +61,7 @@ def solver_command(threads: int, checkpoint_every: float) -> list:
 
 def result_file(out: pathlib.Path) -> pathlib.Path:
     """The run's result: result.h5 once completed, else the partial (running, interrupted) or failed one."""
-    names = ("result.h5", "result.partial.h5", "result.failed.h5")
-    return next((out / n for n in names if (out / n).exists()), out / names[0])
+    return paths.run_result(out) or out / paths.RESULT_NAMES["completed"]
 
 
 def run(threads: int, checkpoint_every: float) -> int:

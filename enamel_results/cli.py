@@ -1,5 +1,5 @@
 """The command line the figure scripts share (--preset, --runs, --out, --allow-missing, --da) and the loading of
-a figure's runs with one clear line when a result file is missing."""
+a figure's runs with one clear line when a result file is missing or damaged."""
 from __future__ import annotations
 
 import argparse
@@ -8,7 +8,7 @@ import sys
 
 from enamel_results import paths
 from enamel_results.paper_values import DEFAULT_SNAPSHOT_DA
-from enamel_results.results import EXIT_MISSING, MissingResult, load_result
+from enamel_results.results import EXIT_DAMAGED, EXIT_MISSING, DamagedResult, MissingResult, load_result
 
 
 def argument_parser(description: str, maps: bool = False) -> argparse.ArgumentParser:
@@ -38,16 +38,31 @@ def fail_missing(script: str, missing: list[pathlib.Path], preset: str) -> None:
     sys.exit(EXIT_MISSING)
 
 
+def fail_damaged(script: str, damaged: list, preset: str) -> None:
+    """One line on stderr per damaged result file ("damaged result ...: rerun"), then exit non-zero."""
+    for e in damaged:
+        print(f"{pathlib.Path(script).name}: {e} (`{paths.make_command(preset)}` reruns it)", file=sys.stderr)
+    sys.exit(EXIT_DAMAGED)
+
+
 def load_cases(script: str, args, cases: list[str], full: bool = False, slow: bool = False) -> dict:
     """{case: Result} for the cases that exist; a missing file ends the script unless --allow-missing
-    (slow twins are optional: missing ones are skipped silently)."""
-    out, missing = {}, []
+    (slow twins are optional: missing ones are skipped silently); a damaged one ends it with a line saying
+    "damaged result ...: rerun" (skipped with that line as a warning under --allow-missing)."""
+    out, missing, damaged = {}, [], []
     for c in cases:
         p = paths.result_file(args.preset, c, slow=slow, runs=args.runs)
         try:
             out[c] = load_result(p, case=c, full=full)
         except MissingResult:
             missing.append(p)
+        except DamagedResult as e:
+            damaged.append(e)
+    if damaged:
+        if not args.allow_missing:
+            fail_damaged(script, damaged, args.preset)
+        for e in damaged:
+            print(f"{pathlib.Path(script).name}: warning: skipping {e}", file=sys.stderr)
     if missing and not slow:
         if args.allow_missing:
             for p in missing:
@@ -55,5 +70,7 @@ def load_cases(script: str, args, cases: list[str], full: bool = False, slow: bo
         else:
             fail_missing(script, missing, args.preset)
     if not out and not slow:
+        if damaged:
+            fail_damaged(script, damaged, args.preset)
         fail_missing(script, missing, args.preset)
     return out

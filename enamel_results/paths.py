@@ -11,6 +11,11 @@ BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.c
 BENCH_RUNS = RUNS / "bench"             # ... and its runs
 BENCH_PAPER_PRESET = BENCH_RUNS / "paper_preset"  # make bench-paper: the one paper-preset case
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
+EXIT_CODES_HEADER = ROOT / "solver" / "lib" / "exit_codes.hpp"  # the solver's exit codes (results.EXIT_CODES)
+
+# The result files of a run directory, by status (solver/lib/output.cpp resultFileFor): result.h5 exists only for a
+# completed run; a run in progress or interrupted has result.partial.h5, a failed one result.failed.h5.
+RESULT_NAMES = {"completed": "result.h5", "partial": "result.partial.h5", "failed": "result.failed.h5"}
 
 
 def case_file(case: str) -> pathlib.Path:
@@ -21,6 +26,17 @@ def case_file(case: str) -> pathlib.Path:
 def result_file(preset: str, case: str, slow: bool = False, runs: pathlib.Path = None) -> pathlib.Path:
     """The HDF5 result of one run; `slow` runs are the half-rate twins. `runs` replaces the runs/ root (tests)."""
     return pathlib.Path(runs or RUNS) / preset / (f"{case}_slow" if slow else case) / "result.h5"
+
+
+def run_result(run_dir, kinds=("completed", "partial", "failed")) -> pathlib.Path | None:
+    """The result file of a run directory: the first of `kinds` (RESULT_NAMES) that exists, None when none does.
+    The default order gives the completed result, else the partial one (running or interrupted), else the failed
+    one; kinds=("completed", "failed") gives a finished run's only."""
+    for kind in kinds:
+        p = pathlib.Path(run_dir) / RESULT_NAMES[kind]
+        if p.is_file():
+            return p
+    return None
 
 
 def figure_dir(preset: str, out: pathlib.Path = None) -> pathlib.Path:

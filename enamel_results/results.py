@@ -9,15 +9,34 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
+import re
+import struct
 import tomllib
+import zlib
 
 import h5py
 import numpy as np
 
+from enamel_results import paths
 from enamel_results.cases import params_from_name
 
-# Exit status when a result file is missing (as the solver's MISSING_FILE, solver/lib/exit_codes.hpp).
-EXIT_MISSING = 3
+
+def read_exit_codes(header: pathlib.Path = paths.EXIT_CODES_HEADER) -> dict[str, int]:
+    """{name: status} of the solver's exit codes, read from their one definition (solver/lib/exit_codes.hpp)."""
+    found = re.findall(r"^constexpr int (\w+) = (\d+);", header.read_text(), re.M)
+    return {name: int(value) for name, value in found}
+
+
+EXIT_CODES = read_exit_codes()
+EXIT_MISSING = EXIT_CODES["missing_file"]      # a result file is missing
+EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or fails its checksum
+
+# The seal enamel-dem writes in the result file's HDF5 user block (solver/lib/output.cpp ResultSeal): magic,
+# format, CRC-32 (zlib.crc32) of the whole file with these 4 bytes as zeros, the file's size; little-endian.
+SEAL = struct.Struct("<8sIIQ")
+SEAL_MAGIC = b"ENAMELRS"
+USERBLOCK_BYTES = 512
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 # Interface tags (/geometry/iface_tag; solver/lib/geometry.hpp InterfaceTag).
 TAG_PLY1, TAG_PLY2, TAG_INTER12, TAG_INTER21 = 0, 1, 2, 3
@@ -27,6 +46,38 @@ class MissingResult(Exception):
     def __init__(self, path: pathlib.Path):
         super().__init__(str(path))
         self.path = pathlib.Path(path)
+
+
+class DamagedResult(OSError):
+    """A result file that is not the one the solver wrote (truncated, overwritten, not HDF5): one line naming it.
+    An OSError, as h5py raises for an unreadable file, so that callers that catch those catch it too."""
+
+    def __init__(self, path: pathlib.Path, why: str):
+        super().__init__(f"damaged result {path} ({why}): rerun the case (delete the file first)")
+        self.path = pathlib.Path(path)
+        self.why = why
+
+
+def verify_result_file(path) -> None:
+    """Raise DamagedResult unless `path` carries the solver's seal and its size and CRC-32 match (files written
+    before the seal, from 2026-12-03 back, begin with HDF5's signature: not checked here, h5py's errors on them
+    are)."""
+    path = pathlib.Path(path)
+    with open(path, "rb") as f:
+        head = f.read(USERBLOCK_BYTES)
+        if head[:len(HDF5_SIGNATURE)] == HDF5_SIGNATURE:
+            return
+        if len(head) < SEAL.size or head[:len(SEAL_MAGIC)] != SEAL_MAGIC:
+            raise DamagedResult(path, "it does not begin with the enamel-dem seal or an HDF5 signature")
+        _, fmt, crc, size = SEAL.unpack_from(head)
+        actual = path.stat().st_size
+        if fmt != 1 or size != actual:
+            raise DamagedResult(path, f"seal format {fmt}, {size} bytes sealed, {actual} bytes on the disk")
+        ours = zlib.crc32(head[:8 + 4] + b"\0\0\0\0" + head[8 + 4 + 4:])  # magic, format, crc as 0, ...
+        while chunk := f.read(1 << 22):
+            ours = zlib.crc32(chunk, ours)
+    if ours != crc:
+        raise DamagedResult(path, f"checksum {crc:08x}, its bytes give {ours:08x}")
 
 
 @dataclasses.dataclass
@@ -134,34 +185,45 @@ def read_frames(frames_group) -> list[Frame]:
 
 
 def load_result(path, case: str | None = None, full: bool = False) -> Result:
-    """Read one result.h5. `full` also reads /geometry and every /frames/<n> (for maps and VTK export)."""
+    """Read one result file. `full` also reads /geometry and every /frames/<n> (for maps and VTK export).
+    MissingResult when there is none; DamagedResult, naming the file, when it fails its seal or HDF5 cannot
+    read what every result file holds."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise MissingResult(path)
-    with h5py.File(path, "r") as f:
-        meta = attributes(f["meta"])
-        rc = attributes(f["rcurve"])
-        case = case or meta.get("case_source", path.parent.name)
-        case = pathlib.Path(case).stem if case.endswith(".toml") else case
-        params = params_from_name(case)
-        try:
-            params.update(tomllib.loads(meta.get("case_toml", "")))
-        except (tomllib.TOMLDecodeError, TypeError):  # a damaged case_toml: keep the name's parameters
-            pass
-        h = f["history"]
-        broken = h["broken_rod_elements"][:]
-        hda = h["da_over_d"][:]
-        first = float(hda[np.argmax(broken > 0)]) if broken.size and broken.max() > 0 else math.nan
-        res = Result(path=path, case=case, params=params, meta=meta,
-                     da=f["rcurve/da_over_d"][:], R=f["rcurve/R_over_Gamma"][:],
-                     R_init=float(rc.get("R_init_over_Gamma", math.nan)),
-                     R_ss=float(rc.get("R_ss_over_Gamma", math.nan)),
-                     R_m=float(rc.get("R_m_over_Gamma", math.nan)),
-                     dR_m=float(rc.get("dR_m_over_Gamma", math.nan)),
-                     da_max=float(rc.get("da_max_over_d", math.nan)),
-                     broken_rods=int(broken[-1]) if broken.size else 0,
-                     da_first_rod_fracture=first)
-        if full:
-            res.geometry = read_geometry(f["geometry"])
-            res.frames = read_frames(f["frames"])
+    verify_result_file(path)
+    try:
+        with h5py.File(path, "r") as f:
+            return read_open_result(f, path, case, full)
+    except (OSError, KeyError, ValueError, TypeError, IndexError) as e:
+        raise DamagedResult(path, f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else 'unreadable'}") from e
+
+
+def read_open_result(f, path: pathlib.Path, case: str | None, full: bool) -> Result:
+    """The Result of an open result file."""
+    meta = attributes(f["meta"])
+    rc = attributes(f["rcurve"])
+    case = case or meta.get("case_source", path.parent.name)
+    case = pathlib.Path(case).stem if case.endswith(".toml") else case
+    params = params_from_name(case)
+    try:
+        params.update(tomllib.loads(meta.get("case_toml", "")))
+    except (tomllib.TOMLDecodeError, TypeError):  # a damaged case_toml: keep the name's parameters
+        pass
+    h = f["history"]
+    broken = h["broken_rod_elements"][:]
+    hda = h["da_over_d"][:]
+    first = float(hda[np.argmax(broken > 0)]) if broken.size and broken.max() > 0 else math.nan
+    res = Result(path=path, case=case, params=params, meta=meta,
+                 da=f["rcurve/da_over_d"][:], R=f["rcurve/R_over_Gamma"][:],
+                 R_init=float(rc.get("R_init_over_Gamma", math.nan)),
+                 R_ss=float(rc.get("R_ss_over_Gamma", math.nan)),
+                 R_m=float(rc.get("R_m_over_Gamma", math.nan)),
+                 dR_m=float(rc.get("dR_m_over_Gamma", math.nan)),
+                 da_max=float(rc.get("da_max_over_d", math.nan)),
+                 broken_rods=int(broken[-1]) if broken.size else 0,
+                 da_first_rod_fracture=first)
+    if full:
+        res.geometry = read_geometry(f["geometry"])
+        res.frames = read_frames(f["frames"])
     return res

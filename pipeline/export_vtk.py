@@ -38,7 +38,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from enamel_results.results import EXIT_MISSING, MissingResult, load_result
+from enamel_results.results import EXIT_DAMAGED, EXIT_MISSING, DamagedResult, MissingResult, load_result
 
 ROD_RADIUS = 0.5  # d: the extreme fibre c of both sections (hexagon across flats d, circle of diameter d)
 
@@ -216,6 +216,9 @@ def main(argv=None) -> int:
         print(f"export_vtk.py: missing result file {e.path}: run the case first "
               f"(`enamel-dem run CASE.toml` or `make runs PRESET=...`)", file=sys.stderr)
         return EXIT_MISSING
+    except DamagedResult as e:
+        print(f"export_vtk.py: {e}", file=sys.stderr)
+        return EXIT_DAMAGED
     for fpath in info["files"]:
         print(fpath)
     print(f"{info['frames']} frames, {info['beams']} rod elements, {info['interfaces']} interfaces",

@@ -150,6 +150,7 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   if (flags.restart && !fs::exists(checkpointPath))
     return fail(exit_code::missing_file, "--restart: no checkpoint '" + checkpointPath +
                                              "' (a run writes one every checkpoint_interval_s and on SIGINT/SIGTERM)");
+  if (flags.restart) checkCheckpoint(checkpointPath, p);  // a bad one is refused before anything is changed
   if (int rc = checkMemory(p)) return rc;
   bool restart = flags.restart;
   if (flags.resume) {  // continue when the checkpoint is this build's and this case's, else start over, saying why
@@ -157,6 +158,8 @@ int runRun(const CaseArgs& args, RunFlags flags) {
     if (fs::exists(checkpointPath)) try {
         checkCheckpoint(checkpointPath, p);
         restart = true;
+      } catch (const CheckpointDamaged&) {
+        throw;  // a damaged file is refused, not replaced: the message says to delete it
       } catch (const CheckpointError& e) {
         why = e.what();
       }
@@ -165,8 +168,8 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   if (int rc = prepareOutput(outDir, flags.force || restart, resultPath)) return rc;
   removeStaleResults(outDir);
   Simulation sim(p);
-  std::signal(SIGINT, requestStop);
-  std::signal(SIGTERM, requestStop);
+  installStopHandlers();
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit (ulimit -f) fails the write (EFBIG), it does not kill the run
   if (!flags.quiet)
     std::fprintf(stderr, "enamel-dem: %s: %d DOF, %d interfaces, dt %.3g, integrator %s -> %s\n",
                  p.sourceName.c_str(), sim.model.numDofs(), sim.model.numInterfaces(), sim.integrator->timeStep(),

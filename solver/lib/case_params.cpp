@@ -513,6 +513,12 @@ std::string writeToml(const CaseParams& p, const std::vector<std::string>& sets)
 
 }  // namespace
 
+bool isResultNeutral(const std::string& key) {
+    for (const char* k : kResultNeutralKeys)
+        if (key == k) return true;
+    return false;
+}
+
 std::string formatKeysMarkdown() {
     auto cell = [](std::string s) {
         std::string out;

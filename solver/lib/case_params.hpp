@@ -203,6 +203,12 @@ struct KeySpec {
 // Every key, in the order of ENAMEL_CASE_KEYS.
 const std::vector<KeySpec>& caseKeys();
 
+// The keys that cannot change a result, only how a run is carried out: a checkpoint written with other values
+// of them continues the same run (checkpoint.cpp); every other key decides whether a checkpoint belongs to it.
+// history_every is not among them: the adaptive loading rate and the stability checks act at history rows.
+inline constexpr const char* kResultNeutralKeys[] = {"threads", "checkpoint_interval_s"};
+bool isResultNeutral(const std::string& key);
+
 // Markdown table of every key: key, group, default, allowed range, unit/normalisation, meaning.
 std::string formatKeysMarkdown();
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <type_traits>
 
+#include "file_io.hpp"
 #include "version.hpp"
 
 namespace enamel {
@@ -14,25 +15,33 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 8;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 9;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
                                        // the record's static elastic start; 5: history rows hold the kinetic
                                        // energy beyond the loading's motion; 6: ... and the inelastic zone's
                                        // reach, the record its edge warning; 7: the static start
                                        // records whether the model held a mechanism; 8: the record its
-                                       // far-field rod break warning
+                                       // far-field rod break warning; 9: a CRC-32 of every byte before it
+                                       // ends the file (before the trailing magic)
+// The file: magic, version, build, case, fields (transferFields), CRC-32 of all that (4 bytes), magic.
+constexpr std::size_t kTrailerBytes = sizeof(std::uint32_t) + sizeof kMagic;
+
+std::string damaged(const std::string& path, const std::string& why) {
+  return "checkpoint '" + path + "' is damaged (" + why + "): delete it to start the run from step 0";
+}
 
 struct Writer {
-  std::ofstream out;
+  std::string out;  // the whole file, written at once (writeFileAtomically)
+  void bytes(const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); }
   template <class T>
   void pod(const T& x) {
     static_assert(std::is_trivially_copyable_v<T>);
-    out.write(reinterpret_cast<const char*>(&x), sizeof x);
+    bytes(&x, sizeof x);
   }
   template <class T>
   void vec(const std::vector<T>& v) {
     pod(static_cast<std::uint64_t>(v.size()));
-    if (!v.empty()) out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
   }
   void vec(const VecX& v) { vec(std::vector<double>(v.data(), v.data() + v.size())); }
   void str(const std::string& s) { vec(std::vector<char>(s.begin(), s.end())); }
@@ -49,16 +58,16 @@ struct Reader {
   template <class T>
   void pod(T& x) {
     in.read(reinterpret_cast<char*>(&x), sizeof x);
-    if (!in) throw CheckpointError("checkpoint '" + path + "' is truncated");
+    if (!in) throw CheckpointDamaged(damaged(path, "it ends inside a field"));
   }
   template <class T>
   void vec(std::vector<T>& v) {
     std::uint64_t n = 0;
     pod(n);
-    if (n > (1ULL << 34)) throw CheckpointError("checkpoint '" + path + "' is corrupt (vector of " + std::to_string(n) + ")");
+    if (n > (1ULL << 34)) throw CheckpointDamaged(damaged(path, "a vector of " + std::to_string(n)));
     v.resize(n);
     if (n) in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-    if (!in) throw CheckpointError("checkpoint '" + path + "' is truncated");
+    if (!in) throw CheckpointDamaged(damaged(path, "it ends inside a field"));
   }
   void vec(VecX& v) {  // the size the freshly built state has
     const Eigen::Index expected = v.size();
@@ -78,7 +87,7 @@ struct Reader {
   void items(std::vector<T>& v, F each) {
     std::uint64_t n = 0;
     pod(n);
-    if (n > (1ULL << 34)) throw CheckpointError("checkpoint '" + path + "' is corrupt (list of " + std::to_string(n) + ")");
+    if (n > (1ULL << 34)) throw CheckpointDamaged(damaged(path, "a list of " + std::to_string(n)));
     v.resize(n);
     for (T& x : v) each(x);
   }
@@ -108,30 +117,73 @@ void transferFields(Io& io, S& s, R& rec) {
   io.pod(rec.staticStart);
 }
 
-// The effective case without its comment lines (the source file as given, the preset, the --set options): the
-// same case given by another path, or with a --set that repeats the value it has anyway, is the same case.
-std::string effectiveKeys(const std::string& toml) {
+// The effective case's keys that can change a result, without its comment lines (the source file as given, the
+// preset, the --set options): the same case given by another path, with a --set that repeats the value it has
+// anyway, or with another value of a result-neutral key (case_params.hpp isResultNeutral: threads, checkpoint
+// interval) is the same run.
+std::string resultKeys(const std::string& toml) {
   std::istringstream in(toml);
   std::string line, keys;
-  while (std::getline(in, line))
-    if (line.empty() || line[0] != '#') keys += line + "\n";
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (isResultNeutral(line.substr(0, line.find(" = ")))) continue;
+    keys += line + "\n";
+  }
   return keys;
 }
 
-// The header: magic, format version, the build that wrote it, the effective case. Throws CheckpointError when
-// the file is not a checkpoint of this format, this build and this case.
+// The stored checksum against the one of the bytes before it, read in pieces (a checkpoint may be larger than
+// the memory a second copy would need). Throws CheckpointDamaged unless they match.
+void verifyChecksum(std::ifstream& in, const std::string& path, std::uint64_t size) {
+  const std::uint64_t body = size - kTrailerBytes;
+  in.seekg(0);
+  std::uint32_t crc = 0;
+  std::vector<char> buf(1 << 20);
+  for (std::uint64_t done = 0; done < body;) {
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(buf.size(), body - done));
+    if (!in.read(buf.data(), static_cast<std::streamsize>(n))) throw CheckpointDamaged(damaged(path, "unreadable"));
+    crc = crc32(buf.data(), n, crc);
+    done += n;
+  }
+  std::uint32_t stored = 0;
+  char magic[8];
+  in.read(reinterpret_cast<char*>(&stored), sizeof stored);
+  in.read(magic, sizeof magic);
+  if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw CheckpointDamaged(damaged(path, "truncated or overwritten at its end"));
+  if (stored != crc) {
+    char why[96];
+    std::snprintf(why, sizeof why, "checksum %08x, its bytes give %08x", stored, crc);
+    throw CheckpointDamaged(damaged(path, why));
+  }
+  in.seekg(static_cast<std::streamoff>(sizeof kMagic + sizeof kVersion));
+}
+
+// The header: magic, format version, the build that wrote it, the effective case; the checksum over the whole
+// file is checked before anything else is read from it. Throws CheckpointDamaged for a damaged file and
+// CheckpointError when it is not a checkpoint of this format, this build and this case.
 void readHeader(Reader& r, const std::string& caseToml) {
   const std::string& path = r.path;
   if (!r.in) throw CheckpointError("no checkpoint '" + path + "' to restart from");
+  r.in.seekg(0, std::ios::end);
+  const std::uint64_t size = static_cast<std::uint64_t>(r.in.tellg());
+  r.in.seekg(0);
   char magic[8];
   r.in.read(magic, sizeof magic);
   if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
-    throw CheckpointError("'" + path + "' is not an enamel-dem checkpoint");
+    throw CheckpointDamaged(damaged(path, "it does not begin as an enamel-dem checkpoint"));
   std::uint32_t version = 0;
   r.pod(version);
+  // A checkpoint of an earlier format carries no checksum: refused for its version (a damaged version field of
+  // this format that happens to read as an earlier one is refused too, under that message).
+  if (version == 0 || version > kVersion)
+    throw CheckpointDamaged(damaged(path, "format version field " + std::to_string(version)));
   if (version != kVersion)
     throw CheckpointError("checkpoint '" + path + "' has format version " + std::to_string(version) +
                           ", this build reads version " + std::to_string(kVersion));
+  if (size < sizeof kMagic + sizeof kVersion + kTrailerBytes)
+    throw CheckpointDamaged(damaged(path, "truncated to " + std::to_string(size) + " bytes"));
+  verifyChecksum(r.in, path, size);
   std::string build;
   r.str(build);
   if (build != buildFingerprint())
@@ -139,7 +191,7 @@ void readHeader(Reader& r, const std::string& caseToml) {
                           "; this is " + buildFingerprint() + "): its continuation would not be bit for bit");
   std::string toml;
   r.str(toml);
-  if (effectiveKeys(toml) != effectiveKeys(caseToml))
+  if (resultKeys(toml) != resultKeys(caseToml))
     throw CheckpointError("checkpoint '" + path + "' was written for a different case (effective keys differ): "
                           "restart with the same case file, --preset and --set options");
 }
@@ -169,21 +221,15 @@ void checkCheckpoint(const std::string& path, const CaseParams& params) {
 }
 
 void writeCheckpoint(const std::string& path, const Simulation& sim, const RunRecord& rec) {
-  const std::string tmp = path + ".tmp";
-  {
-    Writer w{std::ofstream(tmp, std::ios::binary | std::ios::trunc)};
-    if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "'");
-    w.out.write(kMagic, sizeof kMagic);
-    w.pod(kVersion);
-    w.str(buildFingerprint());
-    w.str(sim.params.tomlText);
-    transferFields(w, sim.state, rec);
-    w.out.write(kMagic, sizeof kMagic);  // trailer: a complete file ends with the magic again
-    w.out.flush();
-    if (!w.out) throw CheckpointError("cannot write checkpoint '" + tmp + "' (disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw CheckpointError("cannot rename '" + tmp + "' to '" + path + "'");
+  Writer w;
+  w.bytes(kMagic, sizeof kMagic);
+  w.pod(kVersion);
+  w.str(buildFingerprint());
+  w.str(sim.params.tomlText);
+  transferFields(w, sim.state, rec);
+  w.pod(crc32(w.out.data(), w.out.size()));  // trailer: the checksum of every byte before it, and the magic
+  w.bytes(kMagic, sizeof kMagic);
+  writeFileAtomically(path, w.out, "checkpoint");
 }
 
 void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
@@ -194,10 +240,8 @@ void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
   if (s.lambdaMax.size() != static_cast<std::size_t>(sim.model.numInterfaces()) ||
       s.beamBroken.size() != static_cast<std::size_t>(sim.model.numBeams()))
     throw CheckpointError("checkpoint '" + path + "' does not fit this model");
-  char magic[8];
-  r.in.read(magic, sizeof magic);
-  if (!r.in || std::memcmp(magic, kMagic, sizeof magic) != 0)
-    throw CheckpointError("checkpoint '" + path + "' is truncated");
+  std::uint32_t crc = 0;
+  r.pod(crc);  // checked by readHeader: what follows the fields is the trailer
   sim.replayDeletions();
 }
 

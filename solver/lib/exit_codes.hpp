@@ -1,5 +1,6 @@
 // Process exit codes of enamel-dem: one per class of failure, so that scripts and tests can tell
-// a bad case file from a crashed run without parsing messages.
+// a bad case file from a crashed run without parsing messages. The one definition: the Python side reads
+// this file (enamel_results/results.py EXIT_CODES), so keep one `constexpr int name = value;` per line.
 #pragma once
 
 namespace enamel::exit_code {
@@ -16,6 +17,9 @@ constexpr int output_exists = 9;      // result file already exists and overwrit
 constexpr int run_unstable = 10;      // run diverged: non-finite state, energy balance or kinetic ratio out of bounds
 constexpr int run_failed = 11;        // run stopped on another internal error (solver factorisation, ...)
 constexpr int interrupted = 12;       // run stopped by a signal (SIGINT/SIGTERM); a checkpoint remains for --restart
-constexpr int checkpoint_invalid = 13;  // --restart: the checkpoint is truncated, of another version or another case
+constexpr int checkpoint_invalid = 13;  // --restart: the checkpoint is of another version, build or case
+constexpr int checkpoint_damaged = 14;  // the checkpoint's checksum or structure is wrong: delete it to start over
+constexpr int disk_full = 15;           // a checkpoint or result file did not fit: no space left, quota, file size
+constexpr int result_damaged = 16;      // (Python readers) a result file is truncated or fails its checksum
 
 }  // namespace enamel::exit_code

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <functional>
 #include <numeric>
@@ -14,6 +15,7 @@
 #include "kernels.hpp"
 #include "resources.hpp"
 #include "strength.hpp"
+#include "file_io.hpp"
 #include "version.hpp"
 
 namespace enamel {
@@ -111,6 +113,17 @@ namespace {
 // Peak resident memory of this process (VmHWM of /proc/self/status) in MB; NaN where there is no /proc.
 double peakMemoryMB() { return readProcKilobytes("/proc/self/status", "VmHWM") / 1024.0; }
 
+// The result file's seal in HDF5's user block (see sealImage).
+constexpr hsize_t kUserblockBytes = 512;
+constexpr char kResultMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'R', 'S'};
+struct ResultSeal {
+  char magic[8];
+  std::uint32_t format = 1;  // of this block
+  std::uint32_t crc = 0;     // CRC-32 of the whole file, these 4 bytes as zeros
+  std::uint64_t fileBytes = 0;
+};
+static_assert(sizeof(ResultSeal) == 24, "the seal's layout is read by enamel_results/results.py");
+
 // --- a thin RAII layer over the HDF5 C API ---
 struct Handle {
   hid_t id;
@@ -192,175 +205,212 @@ void historyDataset(hid_t group, const HistoryColumn& c, const std::vector<Measu
   }, c.field);
 }
 
+// /meta: provenance and run status.
+void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
+  const CaseParams& p = sim.params;
+  const double Gamma = p.Gamma();
+  Handle g(H5Gcreate2(file, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/meta");
+  attr(g.id, "case_toml", p.tomlText);
+  attr(g.id, "case_source", p.sourceName);
+  attr(g.id, "preset", p.presetName);
+  attr(g.id, "solver", "enamel-dem");
+  attr(g.id, "solver_version", ENAMEL_VERSION);
+  attr(g.id, "git_hash", kGitHash);
+  attr(g.id, "integrator", sim.integrator->name());
+  attr(g.id, "integrator_details", sim.integrator->describe());
+  attr(g.id, "added_rotary_inertia", sim.integrator->addedRotaryInertia());
+  attr(g.id, "linear_solver", p.linear_solver);
+  attr(g.id, "deletion_rule", p.deletion_rule);
+  attr(g.id, "rod_stress", p.rod_stress);
+  attr(g.id, "seed", static_cast<long>(p.seed));
+  attr(g.id, "strength_generator", kStrengthGenerator);
+  attr(g.id, "status", rec.status);
+  attr(g.id, "stop_reason", rec.stopReason);
+  std::string warnings;
+  for (const auto& w : rec.warnings) warnings += w + "\n";
+  attr(g.id, "warnings", warnings);
+  attr(g.id, "wall_time_s", rec.wallSeconds);
+  attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
+  attr(g.id, "steps", rec.steps);
+  attr(g.id, "dof", static_cast<long>(sim.model.numDofs()));
+  attr(g.id, "threads", static_cast<long>(threadCount()));
+  attr(g.id, "peak_memory_mb", peakMemoryMB());
+  attr(g.id, "written_utc", utcNow());
+  attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "
+                      "(time in d/c_r, c_r = sqrt(E_r/rho_r))");
+  attr(g.id, "dt", sim.integrator->timeStep());
+  attr(g.id, "E_transverse_over_Er", sim.materials.E_transverse);
+  attr(g.id, "c_d_over_cr", sim.materials.c_d);
+  attr(g.id, "rayleigh_a", sim.materials.dampA);
+  attr(g.id, "rayleigh_b", sim.materials.dampB);
+  attr(g.id, "omega_max_element", sim.materials.omegaMaxElement);
+  attr(g.id, "v_app", sim.materials.loading.vApp);
+  attr(g.id, "Gamma_i", Gamma);
+  attr(g.id, "sigma0", p.sigma0());
+  attr(g.id, "k", p.k());
+  attr(g.id, "softening_over_delta0", p.softening_over_delta0);
+  attr(g.id, "sigma_ru_mean", p.sigma_ru());
+  const StaticStart& st = rec.staticStart;
+  attr(g.id, "static_start", st.fraction);
+  attr(g.id, "static_start_description",
+       "static elastic start (case key static_start): the run started at t = static_start_time from the "
+       "static elastic solution at applied displacement static_start_U_over_d = static_start x "
+       "static_start_Uc_over_d, moving at the loading's quasi-static velocity; static_start_Uc_over_d is the "
+       "applied displacement at which the first interface reaches delta0 or the first rod element its "
+       "strength (static_start_limited_by), static_start_solve_s the wall time of the static solve, "
+       "static_start_mechanism 1 when the elastic stiffness was singular (a part free to move without strain, "
+       "e.g. a rod end the pre-crack's cut leaves on one interface, kept where it was). "
+       "static_start = 0: the run started from rest (U_c not computed: NaN)");
+  attr(g.id, "static_start_Uc_over_d", st.firstDamageDisplacement);
+  attr(g.id, "static_start_U_over_d", st.displacement);
+  attr(g.id, "static_start_time", st.time);
+  attr(g.id, "static_start_limited_by",
+       st.fraction > 0 ? (st.limitedByRod ? "rod element strength" : "interface delta0") : "");
+  attr(g.id, "static_start_solve_s", st.solveSeconds);
+  attr(g.id, "static_start_mechanism", static_cast<long>(st.mechanism));
+}
+
+// /rcurve: R over Delta_a and its summary numbers.
+void writeRcurve(hid_t file, const Simulation& sim, const RunRecord& rec) {
+  const double Gamma = sim.params.Gamma();
+  Handle g(H5Gcreate2(file, "rcurve", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/rcurve");
+  std::vector<double> R(rec.rcurveJ.size());
+  for (std::size_t i = 0; i < R.size(); ++i) R[i] = rec.rcurveJ[i] / Gamma;
+  dataset(g.id, "da_over_d", rec.rcurveDa, 1, "d", "crack advance Delta_a / d, one point per advance");
+  dataset(g.id, "R_over_Gamma", R, 1, "Gamma_i", "crack resistance J / Gamma_i at that advance");
+  const RcurveSummary s = summariseRcurve(rec.rcurveDa, R);
+  attr(g.id, "R_init_over_Gamma", s.R_init);
+  attr(g.id, "R_ss_over_Gamma", s.R_ss);
+  attr(g.id, "R_m_over_Gamma", s.R_m);
+  attr(g.id, "dR_m_over_Gamma", s.dR_m);
+  attr(g.id, "da_max_over_d", s.daMax);
+  attr(g.id, "definitions",
+       "R_init: first R with Delta_a > 0; R_ss: mean R over the last 20% of the advance reached; "
+       "R_m, dR_m: mean and standard deviation of R over 0 < Delta_a/d < 30");
+}
+
+// /geometry: the model, for maps and the VTK export.
+void writeGeometry(hid_t file, const Simulation& sim) {
+  const CaseParams& p = sim.params;
+  const Model& m = sim.model;
+  Handle g(H5Gcreate2(file, "geometry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/geometry");
+  std::vector<double> X;
+  for (const auto& x : m.X) X.insert(X.end(), {x.x(), x.y(), x.z()});
+  dataset(g.id, "node_position", X, 3, "d", "reference positions (x growth, y loading, z stacking)");
+  std::vector<int> ply(m.nodePly.begin(), m.nodePly.end());
+  dataset(g.id, "node_ply", ply, 1, "-", "0 = ply 1 (+theta), 1 = ply 2 (-theta)");
+  dataset(g.id, "node_rod", m.nodeRod, 1, "-");
+  dataset(g.id, "node_slice", m.nodeSlice, 1, "-");
+  std::vector<int> bn, in;
+  for (const auto& b : m.beamNodes) bn.insert(bn.end(), {b[0], b[1]});
+  for (const auto& b : m.ifaceNodes) in.insert(in.end(), {b[0], b[1]});
+  dataset(g.id, "beam_nodes", bn, 2, "-");
+  std::vector<int> span(m.beamSpan.begin(), m.beamSpan.end());
+  dataset(g.id, "beam_span", span, 1, "slices",
+          "slices a rod element spans: 1, more in a reduced far field (length span h_e / cos theta)");
+  dataset(g.id, "beam_strength_over_sigma0", [&] {
+    std::vector<double> s(sim.materials.beamStrength);
+    for (double& v : s) v /= p.sigma0();
+    return s; }(), 1, "sigma0");
+  dataset(g.id, "iface_nodes", in, 2, "-", "A, B; B through the z-wrap when iface_zshift = 1");
+  std::vector<int> tag(m.ifaceTag.begin(), m.ifaceTag.end()), zs(m.ifaceZShift.begin(), m.ifaceZShift.end());
+  dataset(g.id, "iface_tag", tag, 1, "-", "0 ply 1, 1 ply 2, 2 interlayer 1-2, 3 interlayer 2-1 (z-wrap)");
+  dataset(g.id, "iface_slice", m.ifaceSlice, 1, "-");
+  dataset(g.id, "iface_zshift", zs, 1, "B");
+  std::vector<double> area, mid;
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    area.push_back(m.ifaceGeom[i].area);
+    const Vec3 c = m.X[m.ifaceNodes[i][0]] + m.ifaceGeom[i].armA;
+    mid.insert(mid.end(), {c.x(), c.y(), c.z()});
+  }
+  dataset(g.id, "iface_area", area, 1, "d^2");
+  dataset(g.id, "iface_midpoint", mid, 3, "d", "centre of the shared Voronoi edge");
+  dataset(g.id, "top_nodes", m.topNodes, 1, "-");
+  dataset(g.id, "bottom_nodes", m.bottomNodes, 1, "-");
+  attr(g.id, "theta_D_deg", p.theta_D);
+  attr(g.id, "w_s", m.w_s);
+  attr(g.id, "h_s", m.h_s);
+  attr(g.id, "a0", m.a0);
+  attr(g.id, "h_e", m.h_e);
+  attr(g.id, "z_period_B", m.B);
+  attr(g.id, "ply_thickness", m.t);
+  attr(g.id, "y_crack_plane", m.yCrack);
+  attr(g.id, "x_crisscross", m.xCrisscross);
+  attr(g.id, "num_slices", static_cast<long>(m.numSlices));
+  attr(g.id, "far_field_slices", static_cast<long>(m.farFieldSlices));
+  attr(g.id, "full_band_half_height", m.hasFarField() ? m.fullHalfHeight : 0.5 * m.h_s);
+}
+
+// /frames/<n>: the damage snapshots.
+void writeFrames(hid_t file, const RunRecord& rec) {
+  Handle g(H5Gcreate2(file, "frames", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames");
+  for (std::size_t i = 0; i < rec.frames.size(); ++i) {
+    const Frame& f = rec.frames[i];
+    const std::string name = std::to_string(i);
+    Handle fg(H5Gcreate2(g.id, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames/" + name);
+    attr(fg.id, "target_da_over_d", f.targetDa);
+    attr(fg.id, "da_over_d", f.da);
+    attr(fg.id, "step", f.step);
+    attr(fg.id, "time", f.time);
+    attr(fg.id, "applied_displacement", f.appliedDisplacement);
+    dataset(fg.id, "node_displacement", f.nodeDisplacement, 6, "d (rotations: rad)", "ux uy uz rx ry rz");
+    dataset(fg.id, "iface_damage", f.ifaceDamage, 1, "-", "1 - secant stiffness / k");
+    dataset(fg.id, "iface_state", f.ifaceState, 1, "-", "0 elastic, 1 inelastic (process zone), 2 failed");
+    dataset(fg.id, "beam_broken", f.beamBroken, 1, "-", "1 = rod element deleted");
+    dataset(fg.id, "beam_stress", f.beamStress, 1, "sigma0",
+            "largest tensile stress of the rod element / sigma0 (the solver's deletion check, "
+            "kernels.cpp computeStressOfBeam); 0 for deleted elements (beam_broken)");
+  }
+}
+
+// The result file's image in memory (HDF5's core driver, no backing store): HDF5 never writes to the disk, so a
+// full disk cannot leave it half-closed, and the bytes written are known before they are written. The file is
+// created with a user block of kUserblockBytes, which the image leaves out (it begins at the superblock, whose
+// base address counts the block): the returned bytes begin with the block, zeros here, for sealImage.
+std::string buildImage(const std::string& path, const Simulation& sim, const RunRecord& rec) {
+  Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation property list");
+  H5Pset_userblock(fcpl.id, kUserblockBytes);
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access property list");
+  H5Pset_fapl_core(fapl.id, 1 << 20, 0);
+  std::string image;
+  {
+    Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.id, fapl.id), H5Fclose, "file '" + path + "' in memory");
+    writeMeta(file.id, sim, rec);
+    writeRcurve(file.id, sim, rec);
+    {
+      Handle g(H5Gcreate2(file.id, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/history");
+      for (const HistoryColumn& c : historyColumns()) historyDataset(g.id, c, rec.history, sim.params.Gamma());
+    }
+    writeGeometry(file.id, sim);
+    writeFrames(file.id, rec);
+    if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("HDF5: cannot flush '" + path + "' in memory");
+    const ssize_t n = H5Fget_file_image(file.id, nullptr, 0);
+    if (n <= 0) throw std::runtime_error("HDF5: no image of '" + path + "'");
+    image.assign(kUserblockBytes + static_cast<std::size_t>(n), '\0');
+    if (H5Fget_file_image(file.id, image.data() + kUserblockBytes, static_cast<std::size_t>(n)) != n)
+      throw std::runtime_error("HDF5: cannot copy the image of '" + path + "'");
+  }
+  return image;
+}
+
+// The user block: kResultMagic, the format of this block, the CRC-32 of the whole file (its own 4 bytes read as
+// zeros) and the file's size (enamel_results/results.py checks them before h5py opens the file).
+std::string& sealImage(std::string& image) {
+  ResultSeal seal;
+  std::memcpy(seal.magic, kResultMagic, sizeof seal.magic);
+  seal.fileBytes = image.size();
+  std::memcpy(image.data(), &seal, sizeof seal);  // crc = 0
+  seal.crc = crc32(image.data(), image.size());
+  std::memcpy(image.data(), &seal, sizeof seal);
+  return image;
+}
+
 }  // namespace
 
 void writeResultFile(const std::string& path, const Simulation& sim, const RunRecord& rec) {
-  const std::string tmp = path + ".tmp";
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become exceptions below, not stderr noise
-  {
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose, "file '" + tmp + "'");
-    const CaseParams& p = sim.params;
-    const Model& m = sim.model;
-    const double Gamma = p.Gamma();
-
-    // --- /meta: provenance and run status ---
-    {
-      Handle g(H5Gcreate2(file.id, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/meta");
-      attr(g.id, "case_toml", p.tomlText);
-      attr(g.id, "case_source", p.sourceName);
-      attr(g.id, "preset", p.presetName);
-      attr(g.id, "solver", "enamel-dem");
-      attr(g.id, "solver_version", ENAMEL_VERSION);
-      attr(g.id, "git_hash", kGitHash);
-      attr(g.id, "integrator", sim.integrator->name());
-      attr(g.id, "integrator_details", sim.integrator->describe());
-      attr(g.id, "added_rotary_inertia", sim.integrator->addedRotaryInertia());
-      attr(g.id, "linear_solver", p.linear_solver);
-      attr(g.id, "deletion_rule", p.deletion_rule);
-      attr(g.id, "rod_stress", p.rod_stress);
-      attr(g.id, "seed", static_cast<long>(p.seed));
-      attr(g.id, "strength_generator", kStrengthGenerator);
-      attr(g.id, "status", rec.status);
-      attr(g.id, "stop_reason", rec.stopReason);
-      std::string warnings;
-      for (const auto& w : rec.warnings) warnings += w + "\n";
-      attr(g.id, "warnings", warnings);
-      attr(g.id, "wall_time_s", rec.wallSeconds);
-      attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
-      attr(g.id, "steps", rec.steps);
-      attr(g.id, "dof", static_cast<long>(sim.model.numDofs()));
-      attr(g.id, "threads", static_cast<long>(threadCount()));
-      attr(g.id, "peak_memory_mb", peakMemoryMB());
-      attr(g.id, "written_utc", utcNow());
-      attr(g.id, "units", "normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 "
-                          "(time in d/c_r, c_r = sqrt(E_r/rho_r))");
-      attr(g.id, "dt", sim.integrator->timeStep());
-      attr(g.id, "E_transverse_over_Er", sim.materials.E_transverse);
-      attr(g.id, "c_d_over_cr", sim.materials.c_d);
-      attr(g.id, "rayleigh_a", sim.materials.dampA);
-      attr(g.id, "rayleigh_b", sim.materials.dampB);
-      attr(g.id, "omega_max_element", sim.materials.omegaMaxElement);
-      attr(g.id, "v_app", sim.materials.loading.vApp);
-      attr(g.id, "Gamma_i", Gamma);
-      attr(g.id, "sigma0", p.sigma0());
-      attr(g.id, "k", p.k());
-      attr(g.id, "softening_over_delta0", p.softening_over_delta0);
-      attr(g.id, "sigma_ru_mean", p.sigma_ru());
-      const StaticStart& st = rec.staticStart;
-      attr(g.id, "static_start", st.fraction);
-      attr(g.id, "static_start_description",
-           "static elastic start (case key static_start): the run started at t = static_start_time from the "
-           "static elastic solution at applied displacement static_start_U_over_d = static_start x "
-           "static_start_Uc_over_d, moving at the loading's quasi-static velocity; static_start_Uc_over_d is the "
-           "applied displacement at which the first interface reaches delta0 or the first rod element its "
-           "strength (static_start_limited_by), static_start_solve_s the wall time of the static solve, "
-           "static_start_mechanism 1 when the elastic stiffness was singular (a part free to move without strain, "
-           "e.g. a rod end the pre-crack's cut leaves on one interface, kept where it was). "
-           "static_start = 0: the run started from rest (U_c not computed: NaN)");
-      attr(g.id, "static_start_Uc_over_d", st.firstDamageDisplacement);
-      attr(g.id, "static_start_U_over_d", st.displacement);
-      attr(g.id, "static_start_time", st.time);
-      attr(g.id, "static_start_limited_by",
-           st.fraction > 0 ? (st.limitedByRod ? "rod element strength" : "interface delta0") : "");
-      attr(g.id, "static_start_solve_s", st.solveSeconds);
-      attr(g.id, "static_start_mechanism", static_cast<long>(st.mechanism));
-    }
-    // --- /rcurve ---
-    {
-      Handle g(H5Gcreate2(file.id, "rcurve", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/rcurve");
-      std::vector<double> R(rec.rcurveJ.size());
-      for (std::size_t i = 0; i < R.size(); ++i) R[i] = rec.rcurveJ[i] / Gamma;
-      dataset(g.id, "da_over_d", rec.rcurveDa, 1, "d", "crack advance Delta_a / d, one point per advance");
-      dataset(g.id, "R_over_Gamma", R, 1, "Gamma_i", "crack resistance J / Gamma_i at that advance");
-      const RcurveSummary s = summariseRcurve(rec.rcurveDa, R);
-      attr(g.id, "R_init_over_Gamma", s.R_init);
-      attr(g.id, "R_ss_over_Gamma", s.R_ss);
-      attr(g.id, "R_m_over_Gamma", s.R_m);
-      attr(g.id, "dR_m_over_Gamma", s.dR_m);
-      attr(g.id, "da_max_over_d", s.daMax);
-      attr(g.id, "definitions",
-           "R_init: first R with Delta_a > 0; R_ss: mean R over the last 20% of the advance reached; "
-           "R_m, dR_m: mean and standard deviation of R over 0 < Delta_a/d < 30");
-    }
-    // --- /history ---
-    {
-      Handle g(H5Gcreate2(file.id, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/history");
-      for (const HistoryColumn& c : historyColumns()) historyDataset(g.id, c, rec.history, Gamma);
-    }
-    // --- /geometry ---
-    {
-      Handle g(H5Gcreate2(file.id, "geometry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/geometry");
-      std::vector<double> X;
-      for (const auto& x : m.X) X.insert(X.end(), {x.x(), x.y(), x.z()});
-      dataset(g.id, "node_position", X, 3, "d", "reference positions (x growth, y loading, z stacking)");
-      std::vector<int> ply(m.nodePly.begin(), m.nodePly.end());
-      dataset(g.id, "node_ply", ply, 1, "-", "0 = ply 1 (+theta), 1 = ply 2 (-theta)");
-      dataset(g.id, "node_rod", m.nodeRod, 1, "-");
-      dataset(g.id, "node_slice", m.nodeSlice, 1, "-");
-      std::vector<int> bn, in;
-      for (const auto& b : m.beamNodes) bn.insert(bn.end(), {b[0], b[1]});
-      for (const auto& b : m.ifaceNodes) in.insert(in.end(), {b[0], b[1]});
-      dataset(g.id, "beam_nodes", bn, 2, "-");
-      std::vector<int> span(m.beamSpan.begin(), m.beamSpan.end());
-      dataset(g.id, "beam_span", span, 1, "slices",
-              "slices a rod element spans: 1, more in a reduced far field (length span h_e / cos theta)");
-      dataset(g.id, "beam_strength_over_sigma0", [&] {
-        std::vector<double> s(sim.materials.beamStrength);
-        for (double& v : s) v /= p.sigma0();
-        return s; }(), 1, "sigma0");
-      dataset(g.id, "iface_nodes", in, 2, "-", "A, B; B through the z-wrap when iface_zshift = 1");
-      std::vector<int> tag(m.ifaceTag.begin(), m.ifaceTag.end()), zs(m.ifaceZShift.begin(), m.ifaceZShift.end());
-      dataset(g.id, "iface_tag", tag, 1, "-", "0 ply 1, 1 ply 2, 2 interlayer 1-2, 3 interlayer 2-1 (z-wrap)");
-      dataset(g.id, "iface_slice", m.ifaceSlice, 1, "-");
-      dataset(g.id, "iface_zshift", zs, 1, "B");
-      std::vector<double> area, mid;
-      for (int i = 0; i < m.numInterfaces(); ++i) {
-        area.push_back(m.ifaceGeom[i].area);
-        const Vec3 c = m.X[m.ifaceNodes[i][0]] + m.ifaceGeom[i].armA;
-        mid.insert(mid.end(), {c.x(), c.y(), c.z()});
-      }
-      dataset(g.id, "iface_area", area, 1, "d^2");
-      dataset(g.id, "iface_midpoint", mid, 3, "d", "centre of the shared Voronoi edge");
-      dataset(g.id, "top_nodes", m.topNodes, 1, "-");
-      dataset(g.id, "bottom_nodes", m.bottomNodes, 1, "-");
-      attr(g.id, "theta_D_deg", p.theta_D);
-      attr(g.id, "w_s", m.w_s);
-      attr(g.id, "h_s", m.h_s);
-      attr(g.id, "a0", m.a0);
-      attr(g.id, "h_e", m.h_e);
-      attr(g.id, "z_period_B", m.B);
-      attr(g.id, "ply_thickness", m.t);
-      attr(g.id, "y_crack_plane", m.yCrack);
-      attr(g.id, "x_crisscross", m.xCrisscross);
-      attr(g.id, "num_slices", static_cast<long>(m.numSlices));
-      attr(g.id, "far_field_slices", static_cast<long>(m.farFieldSlices));
-      attr(g.id, "full_band_half_height", m.hasFarField() ? m.fullHalfHeight : 0.5 * m.h_s);
-    }
-    // --- /frames ---
-    {
-      Handle g(H5Gcreate2(file.id, "frames", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames");
-      for (std::size_t i = 0; i < rec.frames.size(); ++i) {
-        const Frame& f = rec.frames[i];
-        const std::string name = std::to_string(i);
-        Handle fg(H5Gcreate2(g.id, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/frames/" + name);
-        attr(fg.id, "target_da_over_d", f.targetDa);
-        attr(fg.id, "da_over_d", f.da);
-        attr(fg.id, "step", f.step);
-        attr(fg.id, "time", f.time);
-        attr(fg.id, "applied_displacement", f.appliedDisplacement);
-        dataset(fg.id, "node_displacement", f.nodeDisplacement, 6, "d (rotations: rad)", "ux uy uz rx ry rz");
-        dataset(fg.id, "iface_damage", f.ifaceDamage, 1, "-", "1 - secant stiffness / k");
-        dataset(fg.id, "iface_state", f.ifaceState, 1, "-", "0 elastic, 1 inelastic (process zone), 2 failed");
-        dataset(fg.id, "beam_broken", f.beamBroken, 1, "-", "1 = rod element deleted");
-        dataset(fg.id, "beam_stress", f.beamStress, 1, "sigma0",
-                "largest tensile stress of the rod element / sigma0 (the solver's deletion check, "
-                "kernels.cpp computeStressOfBeam); 0 for deleted elements (beam_broken)");
-      }
-    }
-    if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("HDF5: cannot flush '" + tmp + "'");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+  std::string image = buildImage(path, sim, rec);
+  writeFileAtomically(path, sealImage(image), "result file");
 }
 
 }  // namespace enamel

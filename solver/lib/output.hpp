@@ -1,7 +1,9 @@
 #pragma once
 // The result file: one self-describing HDF5 file per run (DESIGN section 6). Every dataset carries its
-// unit or normalisation as an attribute. The file is always written whole to `path.tmp` and renamed over
-// `path`, so a reader (or a run killed half-way) never sees a half-written file.
+// unit or normalisation as an attribute. The file is built in memory and written whole to `path.tmp` and renamed
+// over `path` (file_io.hpp), so a reader (or a run killed half-way) never sees a half-written file and a full
+// disk leaves the previous file. HDF5's 512-byte user block holds a seal: the file's size and a CRC-32 of all
+// its bytes, which enamel_results checks before it reads the file.
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -64,7 +66,8 @@ RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<d
 /// `result.partial.h5`, a failed one leaves `result.failed.h5`.
 std::string resultFileFor(const std::string& dir, const std::string& status);
 
-/// Write the whole result file atomically. Throws std::runtime_error naming the path on failure.
+/// Write the whole result file atomically. Throws WriteError (file_io.hpp) naming the file and its size when it
+/// cannot be written (diskFull: no space or quota), std::runtime_error for an HDF5 error.
 void writeResultFile(const std::string& path, const Simulation& sim, const RunRecord& rec);
 
 }  // namespace enamel

@@ -1,6 +1,9 @@
 #include "runner.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +14,7 @@
 #include <stdexcept>
 
 #include "exit_codes.hpp"
+#include "file_io.hpp"
 #include "loading_rate.hpp"
 
 namespace enamel {
@@ -21,7 +25,6 @@ volatile std::sig_atomic_t gStopSignal = 0;
 // Quasi-static and stability bounds (DESIGN section 4). Warnings are recorded in /meta/warnings;
 // the failure bound stops the run.
 constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
-constexpr double kBalanceFail = 0.25;      // ... above this: the run is unstable, stop
 constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
 constexpr double kEdgeWarnDistance = 2.0;  // d: the inelastic zone this near the loaded edges: warning
 constexpr double kBalanceMinWork = 0.1;    // x Gamma_i B d: the balance error is checked once this much work was done
@@ -60,9 +63,104 @@ double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& no
 
 void requestStop(int signal) { gStopSignal = signal; }
 
+namespace {
+
+// Async-signal-safe pieces of the signal log line: only write(2), open(2), read(2), close(2).
+void put(char*& at, const char* end, const char* text) {
+  while (*text && at < end) *at++ = *text++;
+}
+void putNumber(char*& at, const char* end, long value) {
+  char digits[24];
+  int n = 0;
+  unsigned long v = value < 0 ? 0UL - static_cast<unsigned long>(value) : static_cast<unsigned long>(value);
+  do digits[n++] = static_cast<char>('0' + v % 10); while ((v /= 10) && n < 23);
+  if (value < 0 && at < end) *at++ = '-';
+  while (n > 0 && at < end) *at++ = digits[--n];
+}
+
+// SIGINT/SIGTERM: stop at the next step (requestStop), and say on stderr who sent it (pid, uid, its command
+// name from /proc), so that a run ended on a cluster node can tell SLURM, make or a user apart.
+void onStopSignal(int signal, siginfo_t* info, void*) {
+  const int savedErrno = errno;
+  requestStop(signal);
+  char line[256];
+  char* at = line;
+  const char* end = line + sizeof line - 1;
+  put(at, end, "enamel-dem: received signal ");
+  putNumber(at, end, signal);
+  put(at, end, " from pid ");
+  putNumber(at, end, info ? info->si_pid : -1);
+  put(at, end, " (uid ");
+  putNumber(at, end, info ? static_cast<long>(info->si_uid) : -1);
+  if (info && info->si_pid > 0) {
+    char path[40] = "/proc/";
+    char* p = path + 6;
+    putNumber(p, path + sizeof path - 6, info->si_pid);
+    put(p, path + sizeof path - 1, "/comm");
+    *p = '\0';
+    const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+    if (fd >= 0) {
+      char comm[32];
+      const ssize_t n = ::read(fd, comm, sizeof comm - 1);
+      ::close(fd);
+      if (n > 0) {
+        put(at, end, ", ");
+        for (ssize_t i = 0; i < n && comm[i] != '\n' && at < end; ++i) *at++ = comm[i];
+      }
+    }
+  }
+  put(at, end, "): stopping at the next step with a checkpoint\n");
+  ssize_t ignored = ::write(STDERR_FILENO, line, static_cast<std::size_t>(at - line));
+  (void)ignored;
+  errno = savedErrno;
+}
+
+}  // namespace
+
+void installStopHandlers() {
+  struct sigaction sa = {};
+  sa.sa_sigaction = onStopSignal;
+  sa.sa_flags = SA_SIGINFO | SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  for (int s : {SIGINT, SIGTERM}) sigaction(s, &sa, nullptr);
+}
+
+GuardBounds guardBounds(double Gamma, double B) {
+  GuardBounds b;
+  b.Gamma = Gamma;
+  b.minWork = kBalanceMinWork * Gamma * B;
+  b.negativeJ = 1e-6 * Gamma;
+  return b;
+}
+
+std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBounds& b) {
+  for (double x : {r.J, r.kinetic, r.strainBeams, r.strainInterfaces, r.damping, r.fracture, r.rodFracture,
+                   r.external})
+    if (!std::isfinite(x))
+      return fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
+                 "the time step or the loading is unstable", double(r.step), r.time, r.J, r.kinetic, r.external);
+  const double stored = r.kinetic + r.strainBeams + r.strainInterfaces + r.damping + r.fracture + r.rodFracture;
+  const double balance = std::abs(r.external - stored) / std::max(std::abs(r.external), b.minWork);
+  if (balance > b.balance)
+    return fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g, stored, kinetic "
+               "and dissipated %.4g): energy is created or lost; reduce dt_factor or the loading rate",
+               balance, double(r.step), b.balance, r.external, stored);
+  if (kineticRatio > b.kinetic)
+    return fmt("kinetic / strain energy %.3g at step %.0f exceeds the failure bound %.2g (ten times the largest "
+               "ratio of any completed run measured): the run is not quasi-static, it is blowing up",
+               kineticRatio, double(r.step), b.kinetic);
+  if (r.J < -b.negativeJ)
+    return fmt("J / Gamma_i = %.4g at step %.0f is negative beyond round-off (bound -%.2g): a crack resistance "
+               "cannot be negative; the state is unsound", r.J / b.Gamma, double(r.step), b.negativeJ / b.Gamma);
+  return "";
+}
+
 int exitCodeOf(const std::exception& e) {
   if (const auto* c = dynamic_cast<const CaseError*>(&e)) return c->exitCode;
+  if (dynamic_cast<const CheckpointDamaged*>(&e)) return exit_code::checkpoint_damaged;
   if (dynamic_cast<const CheckpointError*>(&e)) return exit_code::checkpoint_invalid;
+  if (const auto* w = dynamic_cast<const WriteError*>(&e))
+    return w->diskFull ? exit_code::disk_full : exit_code::output_unwritable;
   if (dynamic_cast<const IntegratorError*>(&e) || dynamic_cast<const std::invalid_argument*>(&e))
     return exit_code::out_of_range;
   return exit_code::run_failed;
@@ -78,7 +176,7 @@ class RunLoop {
       : sim_(sim), opt_(opt), p_(sim.params), start_(clock::now()), tty_(isatty(STDERR_FILENO)),
         frameTargets_(p_.frames_da_over_d),
         stopTargets_{p_.stop_da_over_d, p_.stop_u_over_d, double(p_.max_steps)},
-        minWork_(kBalanceMinWork * p_.Gamma() * sim.model.B), burstInterfaces_(burstInterfacesOf(sim.model)),
+        guard_(guardBounds(p_.Gamma(), sim.model.B)), burstInterfaces_(burstInterfacesOf(sim.model)),
         partialPath_(resultFileFor(opt.outDir, "running")) {
     const double dt = sim.integrator->timeStep();
     historyEvery_ = p_.history_every > 0
@@ -127,19 +225,31 @@ class RunLoop {
     if (sim_.state.step == opt_.injectNanAtStep) sim_.state.q[sim_.ops.freeDofs[sim_.ops.freeDofs.size() / 2]] = NAN;
   }
 
-  /// An R-curve point (Delta a, J) each time the crack advanced, and the frames whose targets it passed.
-  void recordRcurvePoint() {
+  /// An R-curve point (Delta a, J) each time the crack advanced, and the frames whose targets it passed; false
+  /// (the run failed) when J is not finite or negative beyond round-off.
+  bool recordRcurvePoint() {
     const State& s = sim_.state;
-    if (!(s.crackAdvance > lastDa_)) return;
+    if (!(s.crackAdvance > lastDa_)) return true;
     if (lastDa_ == 0) {  // the crack starts: its rate is measured from here, its first advance included
       etaSince_ = sample();
       etaSince_.crackAdvance = 0;
     }
     lastDa_ = s.crackAdvance;
     rec_.rcurveDa.push_back(s.crackAdvance);
-    rec_.rcurveJ.push_back(sim_.computeJ());
+    const double J = sim_.computeJ();
+    rec_.rcurveJ.push_back(J);
     while (nextFrame_ < frameTargets_.size() && s.crackAdvance >= frameTargets_[nextFrame_])
       rec_.frames.push_back(captureFrame(sim_, frameTargets_[nextFrame_++]));
+    if (std::isfinite(J) && J >= -guard_.negativeJ) return true;
+    return fail(fmt("R / Gamma_i = %.4g at Delta_a %.3g d (step %.0f) is ", J / p_.Gamma(), s.crackAdvance,
+                    double(s.step)) +
+                (std::isfinite(J) ? "negative beyond round-off" : "not finite") + ": the state is unsound");
+  }
+
+  /// Kinetic / strain energy while the crack grows (before it, the ratio only says how far the load has come).
+  double kineticRatioOf(const Measurement& r) const {
+    const double strain = r.strainBeams + r.strainInterfaces;
+    return sim_.state.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
   }
 
   bool historyDue() const { return sim_.state.step % historyEvery_ == 0; }
@@ -150,25 +260,17 @@ class RunLoop {
   }
 
   /// The quasi-static and stability checks (DESIGN section 4) on a history row: false when the run failed
-  /// (a non-finite state or an energy balance beyond kBalanceFail); warnings are recorded once each.
+  /// (blowUpCheck); warnings are recorded once each.
   bool checkBalance(const Measurement& r) {
     const State& s = sim_.state;
-    for (double x : {r.J, r.kinetic, r.strainBeams, r.strainInterfaces, r.external})
-      if (!std::isfinite(x))
-        return fail(fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
-                        "the time step or the loading is unstable", s.step, s.time, r.J, r.kinetic, r.external));
-    if (r.external > minWork_ && std::abs(r.balanceError) > kBalanceFail)
-      return fail(fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g): "
-                      "energy is created or lost; reduce dt_factor or the loading rate",
-                      r.balanceError, s.step, kBalanceFail, r.external));
-    if (!rec_.warnedBalance && r.external > minWork_ && std::abs(r.balanceError) > kBalanceWarn) {
+    const double kineticRatio = kineticRatioOf(r);
+    const std::string blowUp = blowUpCheck(r, kineticRatio, guard_);
+    if (!blowUp.empty()) return fail(blowUp);
+    if (!rec_.warnedBalance && r.external > guard_.minWork && std::abs(r.balanceError) > kBalanceWarn) {
       rec_.warnedBalance = true;
       rec_.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
                                   kBalanceWarn));
     }
-    const double strain = r.strainBeams + r.strainInterfaces;
-    // Quasi-static check while the crack grows (before it, the ratio only says how far the load has come).
-    const double kineticRatio = s.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
     rec_.maxKineticRatio = std::max(rec_.maxKineticRatio, kineticRatio);
     if (!rec_.warnedKinetic && kineticRatio > kKineticWarn) {
       rec_.warnedKinetic = true;
@@ -283,6 +385,10 @@ class RunLoop {
     if (opt_.progress && tty_) std::fprintf(stderr, "\n");
     if (rec_.status != "failed" || rec_.history.empty() || rec_.history.back().step != sim_.state.step)
       rec_.history.push_back(sim_.measure());
+    if (rec_.status == "completed") {  // the steps since the last checked row: a run blown up there is no result
+      const std::string blowUp = blowUpCheck(rec_.history.back(), kineticRatioOf(rec_.history.back()), guard_);
+      if (!blowUp.empty()) fail(blowUp);
+    }
     rec_.frames.push_back(captureFrame(sim_, -1.0));
     save();
     if (resultFileFor(opt_.outDir, rec_.status) != partialPath_) std::remove(partialPath_.c_str());
@@ -324,7 +430,7 @@ class RunLoop {
   const bool tty_;
   std::vector<double> frameTargets_;
   const StopTargets stopTargets_;
-  const double minWork_;  // the balance error is checked once this much work was done
+  const GuardBounds guard_;  // the blow-up guard's failure bounds
   const int burstInterfaces_;  // the rate controller's burst: more interfaces failed in one interval
   const std::string partialPath_;  // the result file while the run is in progress
   long historyEvery_ = 1;
@@ -343,7 +449,7 @@ RunRecord runSimulation(Simulation& sim, const RunOptions& opt) {
   while (true) {
     sim.step();
     run.injectFault();
-    run.recordRcurvePoint();
+    if (!run.recordRcurvePoint()) break;
     if (run.historyDue()) {
       const Measurement r = run.recordHistory();
       if (!run.checkBalance(r)) break;

@@ -28,7 +28,7 @@ from bench.experiments.check_100.compare import result_file  # the result-file f
 from enamel_results import metrics
 from enamel_results import records as run_records
 from enamel_results.records import R_at
-from enamel_results.paths import PAPER_CASES
+from enamel_results.paths import PAPER_CASES, run_result
 
 HERE = pathlib.Path(__file__).resolve().parent
 CASE = "theta30_s21.4_e10_cv0"
@@ -60,7 +60,7 @@ RUNS_DIR = pathlib.Path("runs") / "far_field"
 def finished(name: str) -> pathlib.Path | None:
     """The run's final result: result.h5, or result.failed.h5 of a run that stopped itself (the edge check's stop
     is a measurement too); None while it has neither."""
-    return next((p for p in (RUNS_DIR / name / "result.h5", RUNS_DIR / name / "result.failed.h5") if p.exists()), None)
+    return run_result(RUNS_DIR / name, kinds=("completed", "failed"))
 
 
 def run_command(binary: pathlib.Path, name: str) -> list[str]:

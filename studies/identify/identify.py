@@ -43,7 +43,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from enamel_results.metrics import rcurve_rel_l2  # noqa: E402
-from enamel_results.paths import ROOT  # noqa: E402
+from enamel_results.paths import ROOT, run_result  # noqa: E402
 from enamel_results.results import MissingResult, load_result  # noqa: E402
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -138,11 +138,7 @@ def rod_break_positions(r) -> dict:
 
 def metrics(size, he, G, case, runs=RUNS) -> dict | None:
     d = run_dir(size, he, G, case, runs)
-    path = None
-    for name in ("result.h5", "result.partial.h5", "result.failed.h5"):
-        if (d / name).is_file():
-            path = d / name
-            break
+    path = run_result(d)
     if path is None:
         return None
     try:

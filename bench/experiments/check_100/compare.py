@@ -19,7 +19,7 @@ import sys
 
 import numpy as np
 
-from enamel_results import metrics
+from enamel_results import metrics, paths
 from enamel_results import records as run_records
 from enamel_results.records import R_at
 
@@ -30,10 +30,7 @@ NAMES = ("rest", "static")
 def result_file(run_dir: pathlib.Path) -> pathlib.Path:
     """result.h5, or result.partial.h5 of a run stopped by Ctrl-C (its status then says interrupted), or
     result.failed.h5 of a run that stopped itself (status failed)."""
-    for name in ("result.h5", "result.partial.h5", "result.failed.h5"):
-        if (pathlib.Path(run_dir) / name).exists():
-            return pathlib.Path(run_dir) / name
-    return pathlib.Path(run_dir) / "result.h5"
+    return paths.run_result(run_dir) or pathlib.Path(run_dir) / paths.RESULT_NAMES["completed"]
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
