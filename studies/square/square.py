@@ -22,7 +22,7 @@ import sys
 import h5py
 import numpy as np
 
-from enamel_results import metrics, paths, results
+from enamel_results import metrics, paths, records, results
 
 HERE = pathlib.Path(__file__).resolve().parent
 DATA = HERE / "data"
@@ -50,13 +50,6 @@ def solver_args(binary, size, G, he, rate, out, sets=()) -> list[str]:
     return args
 
 
-def first_existing(run_dir: pathlib.Path) -> pathlib.Path:
-    for name in ("result.h5", "result.partial.h5", "result.failed.h5"):
-        if (run_dir / name).exists():
-            return run_dir / name
-    raise results.MissingResult(run_dir / "result.h5")
-
-
 def rod_breaks(result_h5: pathlib.Path) -> list[float]:
     """Crack advance at each rod element's deletion, from /history (one entry per element)."""
     with h5py.File(result_h5, "r") as f:
@@ -70,15 +63,16 @@ def rod_breaks(result_h5: pathlib.Path) -> list[float]:
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
-    path = first_existing(run_dir)
+    path = paths.run_result(run_dir)
+    if path is None:
+        raise results.MissingResult(pathlib.Path(run_dir) / paths.RESULT_NAMES["completed"])
     r = results.load_result(path)
     m = r.meta
     keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt", "git_hash",
             "max_kinetic_over_strain_while_growing", "peak_memory_mb", "warnings")
     meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
     meta = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in meta.items()}
-    with h5py.File(path, "r") as f:
-        meta["balance_end"] = float(f["history/energy_balance_error"][-1])
+    meta["balance_end"] = records.history_end(path)["balance_end"]
     params = {k: r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "Gamma_k_over_sigma0sq",
                                       "rate_factor")}
     return dict(name=name, case=r.case, machine=platform.processor() or platform.machine(), cpu=_cpu(),
