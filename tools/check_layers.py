@@ -13,7 +13,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 # Lowest first. A file's layer is that of its stem (foo.hpp and foo.cpp share one).
 LAYERS = [
-    ("base", ["version", "exit_codes", "errors", "git_hash"]),
+    ("base", ["version", "exit_codes", "errors", "git_hash", "file_io"]),
     ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params", "resources"]),
     ("geometry", ["geometry", "far_field"]),
     ("plain data", ["state"]),
