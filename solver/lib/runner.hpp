@@ -64,9 +64,10 @@ struct GuardBounds {
   double balance = 0.25;
   double minWork = 0;     // 0.1 Gamma_i B d: below this much work the error is measured against it
   /// kinetic / strain energy while the crack grows (0.05 is the quasi-static warning). Ten times the largest
-  /// ratio of any completed run recorded before 2026-12-03: 0.299 (studies/far_field record_cv03_m2_h22_allow;
-  /// bench/experiments/check_100 up to 0.156), so 3.0.
-  double kinetic = 3.0;
+  /// ratio of any completed run measured by 2026-12-03: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
+  /// the committed records: 0.299 in studies/far_field record_cv03_m2_h22_allow, up to 0.156 in
+  /// bench/experiments/check_100), so 3.2.
+  double kinetic = 3.2;
   /// J below -negativeJ: negative beyond round-off (1e-6 Gamma_i: J's terms round at ~1e-13 of Gamma_i, and a
   /// sound run's J is never below 0 measured: ci runs of Figs. 4-9, square study rows).
   double negativeJ = 0;
