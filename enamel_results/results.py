@@ -184,6 +184,25 @@ def read_frames(frames_group) -> list[Frame]:
     return out
 
 
+def seal_result_file(path) -> None:
+    """Write the seal of a result file again after a deliberate edit (h5py "r+"), as output.cpp writes it: what
+    an edit changed is then the file's content, not damage. Only for files that carry a seal."""
+    path = pathlib.Path(path)
+    with open(path, "r+b") as f:
+        head = f.read(SEAL.size)
+        if head[:len(SEAL_MAGIC)] != SEAL_MAGIC:
+            raise DamagedResult(path, "no enamel-dem seal to renew")
+        f.seek(0)
+        size = path.stat().st_size
+        f.write(SEAL.pack(SEAL_MAGIC, 1, 0, size))
+        f.seek(0)
+        crc = 0
+        while chunk := f.read(1 << 22):
+            crc = zlib.crc32(chunk, crc)
+        f.seek(0)
+        f.write(SEAL.pack(SEAL_MAGIC, 1, crc, size))
+
+
 def load_result(path, case: str | None = None, full: bool = False) -> Result:
     """Read one result file. `full` also reads /geometry and every /frames/<n> (for maps and VTK export).
     MissingResult when there is none; DamagedResult, naming the file, when it fails its seal or HDF5 cannot

@@ -64,18 +64,24 @@ struct GuardBounds {
   double balance = 0.25;
   double minWork = 0;     // 0.1 Gamma_i B d: below this much work the error is measured against it
   /// kinetic / strain energy while the crack grows (0.05 is the quasi-static warning). Ten times the largest
-  /// ratio of any completed run recorded before 2026-12-03: 0.299 (studies/far_field record_cv03_m2_h22_allow;
-  /// bench/experiments/check_100 up to 0.156), so 3.0.
-  double kinetic = 3.0;
-  /// J below -negativeJ: negative beyond round-off (1e-6 Gamma_i: J's terms round at ~1e-13 of Gamma_i, and a
-  /// sound run's J is never below 0 measured: ci runs of Figs. 4-9, square study rows).
+  /// ratio of any completed run measured by 2026-12-03: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
+  /// the committed records: 0.299 in studies/far_field record_cv03_m2_h22_allow, up to 0.156 in
+  /// bench/experiments/check_100), so 3.2.
+  double kinetic = 3.2;
+  /// An R-curve point (J when the crack advanced) below -negativeJ: negative beyond round-off (1e-6 Gamma_i: J's
+  /// terms round at ~1e-13 of Gamma_i). Only R-curve points: J of a history row may go below 0 in a sound run,
+  /// e.g. in the rebound once the crack has nearly crossed the specimen (J / Gamma_i -0.156 measured at step
+  /// 23840 of theta30_s21.4_e10_cv0 at the ci preset run on with stop_da_over_d=1e3, test_bench.py).
   double negativeJ = 0;
 };
 GuardBounds guardBounds(double Gamma, double B);
 
+/// Whether J can be an R-curve point: finite and not negative beyond round-off.
+bool resistanceIsPhysical(double J, const GuardBounds& b);
+
 /// Why a history row shows a run that blew up, in one sentence naming the check, the step and the values; ""
 /// when it passes: a non-finite energy or J, the energy balance, kinetic / strain energy (`kineticRatio`, 0
-/// before the crack grows), J negative beyond round-off. A pure function of the row.
+/// before the crack grows). A pure function of the row.
 std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBounds& b);
 
 /// Ask a running simulation to stop at the next step (signal handlers call this).

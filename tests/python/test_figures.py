@@ -28,7 +28,7 @@ import pytest
 from enamel_results import cases
 from enamel_results.cases import params_from_name
 from enamel_results.metrics import pooled_rm
-from enamel_results.results import EXIT_MISSING, load_result
+from enamel_results.results import EXIT_MISSING, load_result, seal_result_file
 from figures import plotting, summary_table
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -308,6 +308,7 @@ def test_unfinished_run_is_drawn_and_flagged(tiny_runs, tmp_path):
     shutil.copy(tiny_runs / "ci" / case / "result.h5", runs / "ci" / case / "result.h5")
     with h5py.File(runs / "ci" / case / "result.h5", "r+") as h:
         h["meta"].attrs["status"] = "interrupted"
+    seal_result_file(runs / "ci" / case / "result.h5")  # an edit, not damage
     r = load_result(runs / "ci" / case / "result.h5")
     assert not r.completed and "NOT COMPLETED: interrupted" in plotting.status_flag(r)
     code, _, err = run_script("summary_table", "--preset", "ci", "--runs", runs, "--out", tmp_path / "out",

@@ -276,3 +276,15 @@ def test_a_blown_up_state_fails_the_guard(enamel, checkpoint, tmp_path, name, va
     assert results.load_result(out / "result.failed.h5").status == "failed"
     assert any(w in r.stderr for w in ("energy balance error", "non-finite state", "kinetic / strain energy",
                                        "negative beyond round-off")), r.stderr
+
+
+def test_a_deliberate_edit_is_resealed_and_read(completed, tmp_path):
+    import h5py
+    p = tmp_path / "result.h5"
+    shutil.copy(completed, p)
+    with h5py.File(p, "r+") as f:
+        f["meta"].attrs["status"] = "interrupted"
+    with pytest.raises(results.DamagedResult):
+        results.load_result(p)
+    results.seal_result_file(p)
+    assert results.load_result(p).status == "interrupted"
