@@ -13,7 +13,7 @@ worker() {
     [ -z "$line" ] && return 0
     echo "$(date -u +%FT%TZ) worker $1 starts: $line"
     # shellcheck disable=SC2086
-    $PY -m studies.square.square run $line > "runs/square/log_$(echo $line | tr ' =' '__').txt" 2>&1
+    $PY -m studies.square.square run $line > "runs/square/log_$(echo $line | tr ' =/' '___').txt" 2>&1
     echo "$(date -u +%FT%TZ) worker $1 ends ($?): $line"
   done
 }

@@ -199,9 +199,11 @@ def figure(recs: dict, out: pathlib.Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    for name, rec in recs.items():
-        ls = "-" if rec["params"]["w_s_over_d"] >= 100 else "--"
-        ax.plot(rec["da"], rec["R"], ls, lw=1, label=name)
+    Gs = sorted({rec["params"]["Gamma_k_over_sigma0sq"] for rec in recs.values()})
+    for name, rec in recs.items():   # colour: G; line: solid 100 d and larger, dashed smaller
+        p = rec["params"]
+        ls = "-" if p["w_s_over_d"] >= 100 else ("--" if p["w_s_over_d"] >= 80 else ":")
+        ax.plot(rec["da"], rec["R"], ls, lw=1, label=name, color=f"C{Gs.index(p['Gamma_k_over_sigma0sq'])}")
     ax.axhline(PAPER_LEVEL, color="k", lw=0.8, ls=":", label=f"paper ~{PAPER_LEVEL:g}")
     ax.set_xlabel(r"$\Delta a / d$")
     ax.set_ylabel(r"$R / \Gamma_i$")
