@@ -3,7 +3,6 @@ import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAPER_CASES = ROOT / "paper_cases"
-FIGURE_LIST = PAPER_CASES / "figures.toml"
 PAPER_VALUES = ROOT / "figures" / "paper_values.toml"
 RUNS = ROOT / "runs"
 FIGURES_OUT = ROOT / "figures" / "out"
@@ -11,7 +10,6 @@ BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.c
 BENCH_RUNS = RUNS / "bench"             # ... and its runs
 BENCH_PAPER_PRESET = BENCH_RUNS / "paper_preset"  # make bench-paper: the one paper-preset case
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
-EXIT_CODES_HEADER = ROOT / "solver" / "lib" / "exit_codes.hpp"  # the solver's exit codes (results.EXIT_CODES)
 
 # The result files of a run directory, by status (solver/lib/output.cpp resultFileFor): result.h5 exists only for a
 # completed run; a run in progress or interrupted has result.partial.h5, a failed one result.failed.h5.

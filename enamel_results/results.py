@@ -9,7 +9,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-import re
 import struct
 import tomllib
 import zlib
@@ -17,17 +16,11 @@ import zlib
 import h5py
 import numpy as np
 
-from enamel_results import paths
 from enamel_results.cases import params_from_name
+from enamel_results.constants import EXIT
 
 
-def read_exit_codes(header: pathlib.Path = paths.EXIT_CODES_HEADER) -> dict[str, int]:
-    """{name: status} of the solver's exit codes, read from their one definition (solver/lib/exit_codes.hpp)."""
-    found = re.findall(r"^constexpr int (\w+) = (\d+);", header.read_text(), re.M)
-    return {name: int(value) for name, value in found}
-
-
-EXIT_CODES = read_exit_codes()
+EXIT_CODES = EXIT   # {name: status}, read from the solver's one definition (enamel_results.constants)
 EXIT_MISSING = EXIT_CODES["missing_file"]      # a result file is missing
 EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or fails its checksum
 

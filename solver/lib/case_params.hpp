@@ -2,7 +2,7 @@
 // whose fields it declares (CaseParams), the table it fills (caseKeys), the built-in presets, and the
 // parser that layers
 //     key defaults  <  preset  <  case file  <  --set key=value overrides.
-// All units are normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 (DESIGN.md 1).
+// All units are normalised: rod spacing d = 1, rod modulus E_r = 1, rod density rho_r = 1 (docs/model.md).
 #pragma once
 
 #include <cstdint>
@@ -63,7 +63,7 @@ enum class Need { required, optional };
     X(delta0_over_d, Real, physics, optional, 0.1, "(]", 0, 1, "", "d",                                             \
       "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "          \
       "displacements, so results depend on it only through the loading rate: what is quasi-static is "              \
-      "(v_app/c_d) (h_s / U_c) << 1 with the initiation displacement U_c proportional to delta0 (README, Model)")   \
+      "(v_app/c_d) (h_s / U_c) << 1 with the initiation displacement U_c proportional to delta0 (docs/model.md)")     \
     X(nu_r, Real, physics, optional, 0.3, "[)", 0, 0.5, "", "-",                                                    \
       "rod Poisson ratio: sets the torsional stiffness G J")                                                        \
     X(section, Choice, physics, optional, "hexagon", "[]", 0, 0, "hexagon|circle", "-",                             \
@@ -116,7 +116,7 @@ enum class Need { required, optional };
     X(far_field_slices, Integer, numerics, optional, 1, "[]", 1, 64, "", "slices",                                  \
       "reduced far field: outside the full band |y - h_s/2| <= full_half_height_over_d a rod keeps a node in "      \
       "every this many slices (longer rod elements) and the interfaces there are lumped onto those nodes; the run " \
-      "stops when the inelastic zone comes within 2 d of the band's edge; 1 = off (README, Reduced far field)")    \
+      "stops when the inelastic zone comes within 2 d of the band's edge; 1 = off (docs/solver.md, Reduced far field)") \
     X(full_half_height_over_d, Real, numerics, optional, 0, "[]", 0, 1000, "", "d",                                 \
       "full band half-height: of the reduced far field (far_field_slices > 1): every slice is kept within this "    \
       "distance of the crack plane; at least 1 d")                                                                  \

@@ -1,5 +1,5 @@
 #pragma once
-// Checkpoints: everything a run needs to continue exactly where it was (issue "Hard cases and faults").
+// Checkpoints: everything a run needs to continue exactly where it was (docs/solver.md, Checkpoints and restart).
 // The model, matrices and strengths are rebuilt from the case (deterministic); the checkpoint holds the
 // State (including the order in which rod elements were deleted, so that K and M are rebuilt bit for bit),
 // the reactions and the run record so far. Written whole to `path.tmp` and renamed over `path`, so a run

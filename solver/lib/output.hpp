@@ -1,5 +1,5 @@
 #pragma once
-// The result file: one self-describing HDF5 file per run (DESIGN section 6). Every dataset carries its
+// The result file: one self-describing HDF5 file per run (docs/solver.md, The result file). Every dataset carries its
 // unit or normalisation as an attribute. The file is built in memory and written whole to `path.tmp` and renamed
 // over `path` (file_io.hpp), so a reader (or a run killed half-way) never sees a half-written file and a full
 // disk leaves the previous file. HDF5's 512-byte user block holds a seal: the file's size and a CRC-32 of all
@@ -55,7 +55,7 @@ struct HistoryColumn {
 /// Every column of /history, in the order they are written.
 const std::vector<HistoryColumn>& historyColumns();
 
-/// Summary numbers of an R-curve (DESIGN section 5), normalised by Gamma_i.
+/// Summary numbers of an R-curve (docs/model.md), normalised by Gamma_i.
 struct RcurveSummary {
   double R_init = NAN, R_ss = NAN, R_m = NAN, dR_m = NAN, daMax = 0;
 };

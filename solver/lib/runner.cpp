@@ -22,7 +22,7 @@ namespace enamel {
 namespace {
 volatile std::sig_atomic_t gStopSignal = 0;
 
-// Quasi-static and stability bounds (DESIGN section 4). Warnings are recorded in /meta/warnings;
+// Quasi-static and stability bounds (docs/solver.md, Time integration and checks). Warnings are recorded in /meta/warnings;
 // the failure bound stops the run.
 constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
 constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
@@ -258,7 +258,7 @@ class RunLoop {
     return rec_.history.back();
   }
 
-  /// The quasi-static and stability checks (DESIGN section 4) on a history row: false when the run failed
+  /// The quasi-static and stability checks (docs/solver.md, Time integration and checks) on a history row: false when the run failed
   /// (blowUpCheck); warnings are recorded once each.
   bool checkBalance(const Measurement& r) {
     const State& s = sim_.state;

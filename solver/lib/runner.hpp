@@ -56,7 +56,7 @@ double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& no
 /// case the integrator refuses or a value out of range 7, anything else (a factorisation that failed) 11.
 int exitCodeOf(const std::exception& e);
 
-/// The blow-up guard's failure bounds (DESIGN section 4): a history row beyond any of them fails the run.
+/// The blow-up guard's failure bounds (docs/solver.md, Time integration and checks): a history row beyond any of them fails the run.
 struct GuardBounds {
   double Gamma = 1;       // Gamma_i, for messages
   /// |external work - (stored + kinetic + dissipated)| / max(|external work|, minWork): checked at every row,

@@ -162,7 +162,7 @@ def metrics(size, he, G, case, runs=RUNS) -> dict | None:
     row.update(da=np.asarray(r.da, float), R=np.asarray(r.R, float), breaks=break_points(r),
                theta_D=float(r.param("theta_D")), sigma_ru=float(r.param("sigma_ru_over_sigma0")),
                source="run folder",
-               session=f"{str(r.meta.get('written_utc', ''))[:16].replace('T', ' ')} UTC, solver "
+               written=f"{str(r.meta.get('written_utc', ''))[:16].replace('T', ' ')} UTC, solver "
                        f"{str(r.meta.get('git_hash', '?'))[:12]}")
     return row
 
@@ -205,11 +205,11 @@ def store(m: dict, data: pathlib.Path = DATA) -> pathlib.Path:
     previous = []
     if path.is_file():
         old = json.loads(path.read_text())
-        if old.get("session") == m["session"]:
+        if old.get("written") == m["written"]:
             previous = old.get("previous", [])
         else:
-            previous = old.get("previous", []) + [{"session": old.get("session"), "metrics": old.get("metrics")}]
-    rec = {"session": m["session"],
+            previous = old.get("previous", []) + [{"written": old.get("written"), "metrics": old.get("metrics")}]
+    rec = {"written": m["written"],
            "metrics": {k: _num(m[k]) for k in ROW_KEYS},
            "theta_D": m["theta_D"], "sigma_ru_over_sigma0": m["sigma_ru"],
            "rcurve": {"da_over_d": [_sig(v) for v in m["da"]], "R_over_Gamma": [_sig(v) for v in m["R"]]},
@@ -234,7 +234,7 @@ def stored(size: str, he: float, G: float, case: str, data: pathlib.Path = DATA)
     row.update(da=np.asarray(rc["da_over_d"], float) if rc else None,
                R=np.asarray(rc["R_over_Gamma"], float) if rc else None,
                breaks=rec.get("breaks"), theta_D=float(rec["theta_D"]), sigma_ru=float(rec["sigma_ru_over_sigma0"]),
-               R_at_stored=rec.get("R_at", {}), source="committed data", session=rec["session"],
+               R_at_stored=rec.get("R_at", {}), source="committed data", written=rec["written"],
                path=str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path))
     return row
 
@@ -393,7 +393,7 @@ def read_pairs(data: pathlib.Path = DATA) -> dict:
     if f.is_file():
         with open(f, newline="") as fh:
             for r in csv.DictReader(fh):
-                out[(r["run"], r["ref"])] = (float(r["l2"]), float(r["dmean"]), r["session"])
+                out[(r["run"], r["ref"])] = (float(r["l2"]), float(r["dmean"]), r["written"])
     return out
 
 
@@ -646,7 +646,7 @@ def report(args) -> None:
     out.mkdir(parents=True, exist_ok=True)
     cols = ["size", "w_s", "h_s", "h_e", "G", "case", "status", "da_max", "R_init", "R_ss", "R_m", "R_at3", "R_end",
             "broken_rods", "da_first_rod", "xx_offset_median", "xx_offset_mean", "xx_offset_near_median", "sawtooth_period", "x_breaks",
-            "E_T", "l_over_d", "delta_f_over_d", "wall_s", "path", "source", "session"]
+            "E_T", "l_over_d", "delta_f_over_d", "wall_s", "path", "source", "written"]
     with open(out / "results.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
         w.writeheader()
@@ -675,7 +675,7 @@ def report(args) -> None:
                  f"{fmt(m['da_first_rod'])} | {fmt(m['xx_offset_median'], '.2f')}; {fmt(m['xx_offset_near_median'], '.2f')} | "
                  f"{fmt(m['sawtooth_period'])} | "
                  f"{m['x_breaks'] or '-'} | {fmt(m['wall_s'], '.0f')} | "
-                 f"{'run folder' if m['source'] == 'run folder' else 'committed'}: {m['session']} |")
+                 f"{'run folder' if m['source'] == 'run folder' else 'committed'}: {m['written']} |")
     L += ["", "l = E_T Gamma_i/sigma0^2 (E_T: /meta E_transverse_over_Er); delta_f = (G + 1) sigma0/k. "
           "R_ss: mean R over the last 20% of the advance reached. Unfinished runs (status running/interrupted) "
           "are listed but never used by the rule.", "",

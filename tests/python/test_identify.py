@@ -58,7 +58,7 @@ def test_report_regenerates_from_committed_data(tmp_path):
         g = regen[key(r)]
         assert g["source"] == "committed data"
         for k in ("da_max", "R_init", "R_ss", "R_m", "R_at3", "R_end", "broken_rods", "da_first_rod",
-                  "xx_offset_median", "sawtooth_period", "x_breaks", "wall_s", "session"):
+                  "xx_offset_median", "sawtooth_period", "x_breaks", "wall_s", "written"):
             assert same(r[k], g[k]), (key(r), k, r[k], g[k])
     md = (out / "results.md").read_text()
     assert "committed:" in md and "run folder:" not in md
@@ -87,7 +87,7 @@ def test_store_and_load_round_trip(run, tmp_path):
     for G in (3, 8):
         f, k = folder[G], kept[G]
         assert k["source"] == "committed data" and f["source"] == "run folder"
-        assert k["session"] == f["session"]
+        assert k["written"] == f["written"]
         for name in ("R_init", "R_ss", "R_m", "broken_rods", "da_max", "x_breaks"):
             assert same(str(f[name]), str(k[name]), rel=1e-12), (G, name)
         assert k["da"] == pytest.approx(f["da"], rel=1e-9) and k["R"] == pytest.approx(f["R"], rel=1e-9)

@@ -1,4 +1,4 @@
-"""SLURM (issue 18): `make slurm` writes a job array of the figure set's runs and a figures job after it; here
+"""SLURM: `make slurm` writes a job array of the figure set's runs and a figures job after it; here
 they run on a real single-node SLURM: Debian's slurm-wlm and munge (`make deps`), started by this test as the
 invoking user (root or not: SlurmUser and SlurmdUser are that user, proctrack/linuxproc and task/none need no
 privilege) with its own configuration, munge key, socket, state, spool and logs under a temporary folder, and
