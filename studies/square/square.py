@@ -141,6 +141,9 @@ def run_rows(recs: dict) -> list[str]:
 def compare_line(what: str, ref: str, other: str, recs: dict, tol: float) -> tuple[str, bool]:
     c = metrics.same_rcurve(curve(recs[ref]), curve(recs[other]), tol)
     verdict = "**same**" if c.same else ("not comparable" if not c.comparable else "**differ**")
+    unfinished = [n for n in (ref, other) if recs[n]["meta"].get("status") != "completed"]
+    if unfinished:   # compared over the common range, as the measure allows, and said
+        verdict += f" (over the common range: {', '.join(unfinished)} {recs[unfinished[0]]['meta'].get('status')})"
     wins = ", ".join(f"{pct((wb - wa) / wa)}" for _, _, wa, wb in c.windows)
     return (f"| {what} | {ref} | {other} | {tol:.0%} | (0,{c.hi:.1f}] | {pct(c.mean_rel)} | {pct(c.init_rel)} | "
             f"{c.rods_a} / {c.rods_b} | {wins} | {100 * c.l2:.1f}% | {verdict} |", c.same)

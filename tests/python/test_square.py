@@ -59,3 +59,14 @@ def test_run_arguments_are_the_plans():
     assert sets["w_s_over_d"] == sets["h_s_over_d"] == "100" and sets["Gamma_k_over_sigma0sq"] == "10"
     assert sets["integrator"] == '"lumped"' and sets["dt_factor"] == "0.22" and sets["damping_cap"] == "0.5"
     assert sets["static_start"] == "0.95" and sets["threads"] == "1" and sets["rate_factor"] == "1"
+
+
+def test_a_check_against_an_unfinished_run_says_so(tmp_path):
+    n = square.run_name
+    short = record(n(40, 10, he=0.15), 40, 10, 6.6, he=0.15)
+    short["meta"]["status"] = "interrupted"
+    keep = np.array(short["da"]) <= 15
+    short["da"], short["R"] = list(np.array(short["da"])[keep]), list(np.array(short["R"])[keep])
+    data, readme = write(tmp_path, [record(n(40, 10), 40, 10, 6.5), short])
+    text = square.report(data, readme)
+    assert "**same** (over the common range: s40_he0.15_G10 interrupted)" in text and "| (0,14.8] |" in text
