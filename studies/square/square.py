@@ -192,7 +192,9 @@ def selection(recs: dict, checks: list) -> list[str]:
                      f"{'yes' if rods else '-'} | {'**yes**' if conv else 'no'} |")
         if conv and rods and (best is None or abs(level_G - PAPER_LEVEL) < abs(best[1] - PAPER_LEVEL)):
             best = (G, level_G)
-    lines += ["", f"**Selected: G = {best[0]:g}** ((5,25] mean {best[1]:.2f} against the paper's ~{PAPER_LEVEL:g})."
+    tried = ", ".join(f"{g:g}" for g in sorted({r["params"]["Gamma_k_over_sigma0sq"] for r in recs.values()}))
+    lines += ["", f"**Selected by the records so far: G = {best[0]:g}** ((5,25] mean {best[1]:.2f} against the paper's "
+              f"~{PAPER_LEVEL:g}; values recorded: {tried})."
               if best else "**Selected: none yet** (no G is converged in size, mesh and rate by the records so far)."]
     return lines
 

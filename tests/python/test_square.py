@@ -40,7 +40,7 @@ def test_the_rule_selects_the_converged_G_nearest_7(tmp_path):
     text = square.report(data, readme)
     out = readme.read_text()
     assert out.startswith("# plan\n\nthe rule\n\n## Results\n") and "old text" not in out   # the plan is kept
-    assert "**Selected: G = 10**" in text
+    assert "**Selected by the records so far: G = 10**" in text
     assert "| 8 | yes | - | - |" in text and "| 12 | no | - | - |" in text
     assert "| 10 | yes | yes | yes |" in text
     assert (tmp_path / "rcurves.png").stat().st_size > 1000
