@@ -41,7 +41,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
-from enamel_results import metrics, paths, results  # noqa: E402
+from enamel_results import metrics, paths, records, results  # noqa: E402
 from enamel_results.records import history_end  # noqa: E402
 from enamel_results.constants import KINETIC_WARN  # noqa: E402  the solver's quasi-static warning bound
 from figures import plotting  # noqa: E402
@@ -379,14 +379,7 @@ def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
 
 
 def machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    cpu = records.cpu_model()
     mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30
     return f"{cpu}, {os.cpu_count()} cores, {mem:.0f} GiB, {platform.system()} {platform.release()}"
 

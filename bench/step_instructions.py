@@ -26,7 +26,7 @@ import subprocess
 import sys
 import tempfile
 
-from enamel_results import paths
+from enamel_results import paths, records
 
 CASE = paths.case_file("theta30_s21.4_e10_cv0")
 SETS = {"w_s_over_d": "40", "h_s_over_d": "20", "integrator": '"lumped"', "dt_factor": "0.22",
@@ -123,16 +123,9 @@ def git(binary) -> str:
     return r.stdout.strip() or "?"
 
 
-def cpu() -> str:
-    for line in open("/proc/cpuinfo"):
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "?"
-
-
 def markdown(runs: list[tuple[str, dict]], sizes: dict, wall: str) -> str:
     L = ["# Instructions and cache misses per time step, per kernel (`make bench-step`)", "",
-         f"{datetime.date.today()}, {cpu()}. Model: theta30 (21.4, 10), 40 x 20 d, h_e 0.3 d, lumped, one thread: "
+         f"{datetime.date.today()}, {records.cpu_model()}. Model: theta30 (21.4, 10), 40 x 20 d, h_e 0.3 d, lumped, one thread: "
          f"{sizes['DOF']} DOF, {sizes['nodes']} nodes, {sizes['interfaces']} interfaces; valgrind callgrind with "
          f"its cache simulation, {STEPS} steps per kernel in the profile's interleaved rounds. Counts per call, "
          "divided by what each kernel loops over; D1/LL = first/last-level data-cache misses (reads + writes).", "",

@@ -14,6 +14,17 @@ RECORD_META = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s"
                "max_kinetic_over_strain_while_growing", "peak_memory_mb", "git_hash", "static_start")
 
 
+def cpu_model() -> str:
+    """The machine's CPU model (/proc/cpuinfo's "model name"), for the provenance of records and benches."""
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown CPU"
+
+
 def history_end(result_h5) -> dict:
     """The last /history row's applied displacement, time and energy-balance error (results.load_result
     reads /meta and the R-curve, not these)."""

@@ -3,8 +3,9 @@
 
     python3 -m studies.square.rejudge      # writes rejudged.md here
 
-Records without a stored R-curve (the first identification session's) cannot be judged and are listed as such;
-bench/experiments/rate_theta30/ kept no curves at all (its README gives L2 only).
+Records without a stored R-curve (those of the first identification round, 2026-12-02 00:21-02:15 UTC, solver
+f7bcd03) cannot be judged and are listed as such; bench/experiments/rate_theta30/ kept no curves at all (its
+README gives L2 only).
 """
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pathlib
 import sys
 
 from enamel_results import metrics, paths
-from studies.square.square import PAIR_HEAD, pct
+from studies.square.square import PAIR_HEAD, comparison_row
 
 HERE = pathlib.Path(__file__).resolve().parent
 IDENTIFY = paths.ROOT / "studies" / "identify" / "data"
@@ -60,11 +61,7 @@ def pairs() -> list[tuple[str, str, str, float, metrics.RCurve | None, metrics.R
 def line(what, ref, other, tol, a, b) -> str:
     if a is None or b is None:
         return f"| {what} | {ref} | {other} | {tol:.0%} | - | - | - | - | - | - | no stored R-curve: cannot be judged |"
-    c = metrics.same_rcurve(a, b, tol)
-    verdict = "**same**" if c.same else ("not comparable" if not c.comparable else "**differ**")
-    wins = ", ".join(pct((wb - wa) / wa) for _, _, wa, wb in c.windows) or "-"
-    return (f"| {what} | {ref} | {other} | {tol:.0%} | (0,{c.hi:.1f}] | {pct(c.mean_rel)} | {pct(c.init_rel)} | "
-            f"{c.rods_a} / {c.rods_b} | {wins} | {100 * c.l2:.1f}% | {verdict} |")
+    return comparison_row(what, ref, other, tol, a, b)[0]
 
 
 def main() -> int:

@@ -15,7 +15,6 @@ import argparse
 import json
 import math
 import pathlib
-import platform
 import subprocess
 import sys
 
@@ -31,7 +30,6 @@ CASE = "theta30_s21.4_e10_cv0"
 PAPER_LEVEL = 7.0            # the paper's R/Gamma_i "at Delta_a ~ 15 d" for this case (the rule's target)
 SELECT_WINDOW = (5.0, 25.0)  # the rule's mean
 NUMERICS = {"integrator": '"lumped"', "dt_factor": "0.22", "damping_cap": "0.5", "static_start": "0.95"}
-CURVE_DIGITS = 10
 
 
 def run_name(size: float, G: float, he: float = 0.3, rate: float = 1.0, extra: str = "") -> str:
@@ -63,32 +61,17 @@ def rod_breaks(result_h5: pathlib.Path) -> list[float]:
 
 
 def record_of(run_dir: pathlib.Path, name: str) -> dict:
+    """enamel_results.records.record_of, plus the study's keys, the crack advance of every rod break and the CPU."""
     path = paths.run_result(run_dir)
     if path is None:
         raise results.MissingResult(pathlib.Path(run_dir) / paths.RESULT_NAMES["completed"])
+    rec = records.record_of(path, name)
     r = results.load_result(path)
-    m = r.meta
-    keep = ("status", "stop_reason", "steps", "dof", "threads", "wall_time_s", "dt", "git_hash",
-            "max_kinetic_over_strain_while_growing", "peak_memory_mb", "warnings")
-    meta = {k: (m[k].item() if hasattr(m.get(k), "item") else m.get(k)) for k in keep if k in m}
-    meta = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in meta.items()}
-    meta["balance_end"] = records.history_end(path)["balance_end"]
-    params = {k: r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "Gamma_k_over_sigma0sq",
-                                      "rate_factor")}
-    return dict(name=name, case=r.case, machine=platform.processor() or platform.machine(), cpu=_cpu(),
-                meta=meta, params=params, R_init=r.R_init, da_max=r.da_max, broken_rods=r.broken_rods,
-                rod_da=[float(f"{x:.6g}") for x in rod_breaks(path)],
-                da=[float(f"{x:.{CURVE_DIGITS}g}") for x in r.da], R=[float(f"{x:.{CURVE_DIGITS}g}") for x in r.R])
-
-
-def _cpu() -> str:
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.machine()
+    rec["params"] = {k: r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "Gamma_k_over_sigma0sq",
+                                             "rate_factor")}
+    rec["rod_da"] = [float(f"{x:.6g}") for x in rod_breaks(path)]
+    rec["cpu"] = records.cpu_model()
+    return rec
 
 
 def store(rec: dict, data: pathlib.Path = DATA) -> pathlib.Path:
@@ -138,15 +121,22 @@ def run_rows(recs: dict) -> list[str]:
     return lines
 
 
-def compare_line(what: str, ref: str, other: str, recs: dict, tol: float) -> tuple[str, bool]:
-    c = metrics.same_rcurve(curve(recs[ref]), curve(recs[other]), tol)
-    verdict = "**same**" if c.same else ("not comparable" if not c.comparable else "**differ**")
-    unfinished = [n for n in (ref, other) if recs[n]["meta"].get("status") != "completed"]
-    if unfinished:   # compared over the common range, as the measure allows, and said
-        verdict += f" (over the common range: {', '.join(unfinished)} {recs[unfinished[0]]['meta'].get('status')})"
-    wins = ", ".join(f"{pct((wb - wa) / wa)}" for _, _, wa, wb in c.windows)
+def comparison_row(what: str, ref: str, other: str, tol: float, a: metrics.RCurve, b: metrics.RCurve,
+                   note: str = "") -> tuple[str, bool]:
+    """One table row of the measure (same_rcurve of b against a) and its verdict; `note` follows the verdict."""
+    c = metrics.same_rcurve(a, b, tol)
+    verdict = ("**same**" if c.same else ("not comparable" if not c.comparable else "**differ**")) + note
+    wins = ", ".join(pct((wb - wa) / wa) for _, _, wa, wb in c.windows) or "-"
     return (f"| {what} | {ref} | {other} | {tol:.0%} | (0,{c.hi:.1f}] | {pct(c.mean_rel)} | {pct(c.init_rel)} | "
             f"{c.rods_a} / {c.rods_b} | {wins} | {100 * c.l2:.1f}% | {verdict} |", c.same)
+
+
+def compare_line(what: str, ref: str, other: str, recs: dict, tol: float) -> tuple[str, bool]:
+    unfinished = [n for n in (ref, other) if recs[n]["meta"].get("status") != "completed"]
+    # compared over the common range, as the measure allows, and said
+    note = (f" (over the common range: {', '.join(unfinished)} {recs[unfinished[0]]['meta'].get('status')})"
+            if unfinished else "")
+    return comparison_row(what, ref, other, tol, curve(recs[ref]), curve(recs[other]), note)
 
 
 PAIR_HEAD = ["| check | reference | other | tolerance | range | R mean | R_init | broken rods | windows | L2 (reported) | verdict |",
