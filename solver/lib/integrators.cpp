@@ -306,7 +306,11 @@ class LumpedIntegrator : public Integrator {
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();
     gripOfDof_.assign(m.numDofs(), -1);
-    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) gripOfDof_[ops.prescribedDofs[i]] = static_cast<int>(i);
+    nodeHasGrip_.assign(m.numNodes(), 0);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
+      gripOfDof_[ops.prescribedDofs[i]] = static_cast<int>(i);
+      nodeHasGrip_[ops.prescribedDofs[i] / 6] = 1;
+    }
     gripResidual_ = VecX::Zero(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
     for (double shape : ops.prescribedShape) largestShape_ = std::max(largestShape_, std::abs(shape));
     omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
@@ -374,75 +378,91 @@ class LumpedIntegrator : public Integrator {
   }
 
  private:
+  // The constants of a step's velocity update.
+  struct NodeStep {
+    double keep, scale, dt, b, Vgrip;  // 1 - a dt/2, 1 + a dt/2, dt, b', V(t_n + dt/2)
+  };
+
   // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a
   // slice in a fixed order, so nothing depends on the thread count). Per slice:
-  //   f_iface of its interfaces (opening, law, force on B; their history updated at q_n)
-  //   per node: the interfaces' wrench, K q_n and K v_{n-1/2} (its block row), r = K q + f_iface + b' K v,
+  //   the wrench of its interfaces on its nodes (opening, law, force on B; their history updated at q_n)
+  //   per node (advanceVelocityOfNode): K q_n and K v_{n-1/2} (its block row), r = K q + f_iface + b' K v,
   //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
   //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
   //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
   // v_{n+1/2} goes to vNext_ (K v_{n-1/2} of the next slice still reads v_{n-1/2}) and replaces v at the end.
   // Returns the number of failed interfaces.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
-    using Pair = DoublePair;
     const cohesive::Law law = mat.law;
-    const double a = dampA_, dt = dt_, b = bEff_, keep = 1.0 - 0.5 * a * dt, scale = 1.0 + 0.5 * a * dt;
-    const double Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
+    NodeStep step;
+    step.keep = 1.0 - 0.5 * dampA_ * dt_;
+    step.scale = 1.0 + 0.5 * dampA_ * dt_;
+    step.dt = dt_;
+    step.b = bEff_;
+    step.Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
     vNext_.resize(s.vHalf.size());
     sliceWorkM_.assign(m.numSlices, 0.0);
     sliceWorkK_.assign(m.numSlices, 0.0);
     const double* q = s.q.data();
-    const double* v = s.vHalf.data();
-    double* vNext = vNext_.data();
     double* lambda = s.lambdaMax.data();
-    const NodeBlockMatrix& K = Kblocks_;
-    const bool split = !K.split.empty();
     int failed = 0;
-#pragma omp parallel reduction(+ : failed) firstprivate(law, q, v, vNext, lambda)
+#pragma omp parallel reduction(+ : failed) firstprivate(law, q, lambda, step)
     {
-      std::vector<cohesive::Vec3> onB(ops.maxIfacesPerSlice);
+      std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
       for (int k = 0; k < m.numSlices; ++k) {
-        failed += computeForcesForInterfacesOfSlice(m, law, ops, k, s.q, lambda, true, onB.data());
-        double workM = 0, workK = 0;
-        for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
-          Vec3 F, Mo;
-          gatherInterfaceWrench(ops, node, onB.data(), ops.sliceIfaceStart[k], F, Mo);
-          Vec6 fI;
-          fI << -F, -Mo;
-          Vec6 Kq, Kv;
-          if (split)
-            multiplyBlockRowSplit(K, node, q, v, Kq, Kv);
-          else
-            multiplyBlockRow(K, node, q, v, Kq, Kv);
-          // r and the free DOFs' v_{n+1/2}, two DOFs at a time (the same operations per DOF); then the grips
-          double r[6], vFree[6];
-          const double* vNode = v + 6 * node;
-          const double* invM = invMass_.data() + 6 * node;
-          for (int j = 0; j < 6; j += 2) {
-            const Pair rj = (Pair{Kq[j], Kq[j + 1]} + Pair{fI[j], fI[j + 1]}) + Pair{b, b} * Pair{Kv[j], Kv[j + 1]};
-            const Pair vj = (Pair{keep, keep} * Pair{vNode[j], vNode[j + 1]} - Pair{dt, dt} * (Pair{invM[j], invM[j + 1]} * rj)) /
-                            Pair{scale, scale};
-            r[j] = rj[0], r[j + 1] = rj[1], vFree[j] = vj[0], vFree[j + 1] = vj[1];
-          }
-          for (int j = 0; j < 6; ++j) {
-            const int dof = 6 * node + j;
-            const int grip = gripOfDof_[dof];
-            double vn = vFree[j];
-            if (grip >= 0) {
-              vn = ops.prescribedShape[grip] * Vgrip;
-              gripResidual_[grip] = r[j];
-            }
-            vNext[dof] = vn;
-            workM += vn * (mass_[dof] * vn);
-            workK += vn * Kv[j];
-          }
-        }
-        sliceWorkM_[k] = workM;
-        sliceWorkK_[k] = workK;
+        failed += addInterfaceWrenchesOfSlice(m, law, ops, k, q, lambda, true, wrench.data());
+        double work[2] = {0, 0};
+        const int firstNode = ops.sliceNodeStart[k];
+        for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
+          advanceVelocityOfNode(ops, step, node, q, s.vHalf.data(), wrench.data() + 6 * (node - firstNode), work);
+        sliceWorkM_[k] = work[0];
+        sliceWorkK_[k] = work[1];
       }
     }
     return failed;
+  }
+
+  // One node's v_{n+1/2} into vNext_ from its block row of K times q and v (= v_{n-1/2}) and the wrench of its
+  // interfaces W (f_iface = -W, so r = K q - W + b' K v); work[0] += v.Mv, work[1] += v.Kv over its DOFs in
+  // order. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
+  [[gnu::always_inline]] inline void advanceVelocityOfNode(const Operators& ops, const NodeStep& c, int node,
+                                                           const double* q, const double* v, const double* W,
+                                                           double* work) {
+    using Pair = DoublePair;
+    const NodeBlockMatrix& K = Kblocks_;
+    Pair Kq[3], Kv[3];
+    if (!K.split.empty()) {
+      multiplyBlockRowSplitPairs(K, node, q, v, Kq, Kv);
+    } else {
+      Vec6 a, b;
+      multiplyBlockRow(K, node, q, v, a, b);
+      for (int j = 0; j < 3; ++j) Kq[j] = Pair{a[2 * j], a[2 * j + 1]}, Kv[j] = Pair{b[2 * j], b[2 * j + 1]};
+    }
+    auto pairs = [node](const double* x) { return static_cast<const Pair*>(__builtin_assume_aligned(x + 6 * node, 16)); };
+    const Pair *vNode = pairs(v), *invM = pairs(invMass_.data()), *mass = pairs(mass_.data());
+    const Pair* Wp = static_cast<const Pair*>(__builtin_assume_aligned(W, 16));
+    Pair r[3], vn[3];
+    for (int j = 0; j < 3; ++j) {
+      r[j] = (Kq[j] - Wp[j]) + Pair{c.b, c.b} * Kv[j];
+      vn[j] = (Pair{c.keep, c.keep} * vNode[j] - Pair{c.dt, c.dt} * (invM[j] * r[j])) / Pair{c.scale, c.scale};
+    }
+    if (nodeHasGrip_[node])
+      for (int j = 0; j < 6; ++j) {
+        const int grip = gripOfDof_[6 * node + j];
+        if (grip < 0) continue;
+        vn[j / 2][j % 2] = ops.prescribedShape[grip] * c.Vgrip;
+        gripResidual_[grip] = r[j / 2][j % 2];
+      }
+    Pair* out = static_cast<Pair*>(__builtin_assume_aligned(vNext_.data() + 6 * node, 16));
+    double workM = work[0], workK = work[1];
+    for (int j = 0; j < 3; ++j) {
+      out[j] = vn[j];
+      const Pair m = vn[j] * (mass[j] * vn[j]), k = vn[j] * Kv[j];
+      workM += m[0], workK += k[0];
+      workM += m[1], workK += k[1];
+    }
+    work[0] = workM, work[1] = workK;
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
@@ -484,6 +504,7 @@ class LumpedIntegrator : public Integrator {
   double moveBound_ = INFINITY;      // lastStepMoveBound
   VecX mass_, invMass_, fI_, vNext_, vGripBefore_, vGrip_, gripResidual_;
   std::vector<int> gripOfDof_;                 // index into ops.prescribedDofs; -1 for a free DOF
+  std::vector<std::uint8_t> nodeHasGrip_;      // per node: 1 when one of its DOFs is prescribed
   std::vector<double> sliceWorkM_, sliceWorkK_;  // each slice's share of the damping work's two sums
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
 };

@@ -73,20 +73,36 @@ void applyBoundaryConditions(const Operators& ops, const Loading& loading, doubl
 }
 
 // --- interfaces ----------------------------------------------------------------------------------------
-[[gnu::flatten]] int computeForcesForInterfacesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k, const VecX& q,
-                                      double* lambdaMax, bool update, cohesive::Vec3* onB) {
+namespace {
+// w += the wrench of one interface end (six doubles: force, moment)
+[[gnu::always_inline]] inline void addWrench(double* w, const cohesive::Wrench& e) {
+  for (int c = 0; c < 3; ++c) w[c] += e.force[c], w[3 + c] += e.moment[c];
+}
+}  // namespace
+
+// Per interface: its force on B (the compact form's opening, law and force), then the wrench on A and on B
+// added to their nodes' six sums. A node's sum receives its interface ends in ascending interface order, the
+// order of the CSR Operators::nodeIfaceList, from +0: the sums a per-node gather in that order would make.
+[[gnu::flatten]] int addInterfaceWrenchesOfSlice(const Model& m, const cohesive::Law& lawGiven, const Operators& ops,
+                                                 int k, const double* q, double* lambdaMax, bool update,
+                                                 double* wrench) {
+  const cohesive::Law law = lawGiven;  // a local copy: the stores below cannot alias it, so it stays in registers
   int failed = 0;
-  const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1];
+  const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1], firstNode = ops.sliceNodeStart[k];
+  std::fill(wrench, wrench + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
   const auto* nodes = m.ifaceNodes.data();
+  const cohesive::SliceInterface* packed = ops.ifacePacked.data();
+  using Map3 = Eigen::Map<const cohesive::Vec3>;
   for (int i = first; i < last; ++i) {
     const int A = nodes[i][0], B = nodes[i][1];
     const double before = lambdaMax[i];
     double lm = before;
-    onB[i - first] = cohesive::computeInterfaceForceOnB(law, ops.ifacePacked[i], q.segment<3>(6 * A),
-                                                        q.segment<3>(6 * A + 3), q.segment<3>(6 * B),
-                                                        q.segment<3>(6 * B + 3), lm);
+    const cohesive::Vec3 F = cohesive::computeInterfaceForceOnB(law, packed[i], Map3(q + 6 * A), Map3(q + 6 * A + 3),
+                                                                Map3(q + 6 * B), Map3(q + 6 * B + 3), lm);
     if (update && lm != before) lambdaMax[i] = lm;  // most interfaces keep theirs: no store
     failed += cohesive::isFailed(law, lm);
+    addWrench(wrench + 6 * (A - firstNode), cohesive::wrenchOnSide(packed[i], F, false));
+    addWrench(wrench + 6 * (B - firstNode), cohesive::wrenchOnSide(packed[i], F, true));
   }
   return failed;
 }
@@ -98,20 +114,7 @@ cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i) {
                                             q.segment<3>(6 * B + 3));
 }
 
-[[gnu::flatten]] void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
-                           Vec3& moment) {
-  double f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};  // plain sums (Eigen's 3-vector sums go through memory here)
-  for (int k = ops.nodeIfaceStart[node]; k < ops.nodeIfaceStart[node + 1]; ++k) {
-    const int i = ops.nodeIfaceList[k] >> 1;
-    const cohesive::Wrench w = cohesive::wrenchOnSide(ops.ifacePacked[i], onB[i - firstIface], ops.nodeIfaceList[k] & 1);
-    for (int c = 0; c < 3; ++c) f[c] += w.force[c], mo[c] += w.moment[c];
-  }
-  force = Vec3(f[0], f[1], f[2]);
-  moment = Vec3(mo[0], mo[1], mo[2]);
-}
-
-// f_iface = -(forces exerted on the nodes), slice by slice: F_B of the slice's interfaces into a buffer of the
-// thread, then per node of the slice the sum over its interface ends of the wrench on that side.
+// f_iface = -(the wrench the interfaces exert on each node), slice by slice into a buffer of the thread.
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, VecX& f) {
   f.resize(m.numDofs());
@@ -122,16 +125,12 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
   int failed = 0;
 #pragma omp parallel reduction(+ : failed) firstprivate(lawHere, lambda)
   {
-    std::vector<cohesive::Vec3> onB(ops.maxIfacesPerSlice);
+    std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
     for (int k = 0; k < m.numSlices; ++k) {
-      failed += computeForcesForInterfacesOfSlice(m, lawHere, ops, k, q, lambda, update, onB.data());
-      for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
-        Vec3 F, Mo;
-        gatherInterfaceWrench(ops, node, onB.data(), ops.sliceIfaceStart[k], F, Mo);
-        f.segment<3>(6 * node) = -F;
-        f.segment<3>(6 * node + 3) = -Mo;
-      }
+      failed += addInterfaceWrenchesOfSlice(m, lawHere, ops, k, q.data(), lambda, update, wrench.data());
+      const int firstNode = ops.sliceNodeStart[k];
+      for (int dof = 6 * firstNode; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) f[dof] = -wrench[dof - 6 * firstNode];
     }
   }
   return failed;

@@ -22,25 +22,20 @@ double computeGripVelocity(const Loading& loading, const State& s, double h, dou
 /// phi U'(tau), phi^2 U''(tau) + phi' U'(tau).
 void applyBoundaryConditions(const Operators& ops, const Loading& loading, double dt, State& s);
 
-/// The forces of the interfaces of slice k on their node B (cohesive::computeInterfaceForceOnB of the
-/// compact geometry), into onB[i - first interface of the slice]; lambdaMax is updated only when `update`.
-/// Returns the number of failed interfaces of the slice (with the history as updated, or as it would be).
-int computeForcesForInterfacesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k, const VecX& q,
-                                      double* lambdaMax, bool update, cohesive::Vec3* onB);
-
+/// The wrench (force, moment) that the interfaces of slice k exert on each of its nodes, into wrench[6 (node -
+/// first node of the slice) + 0..5]: per interface its force on B (cohesive::computeInterfaceForceOnB of the
+/// compact geometry) and the wrench on either side (cohesive::wrenchOnSide) added to its two nodes, in
+/// ascending interface order (so nothing depends on the thread count). lambdaMax is updated only when
+/// `update`. Returns the number of failed interfaces of the slice (with the history as updated, or as it
+/// would be).
+int addInterfaceWrenchesOfSlice(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
+                                const double* q, double* lambdaMax, bool update, double* wrench);
 /// The local opening (n, t1, t2) of interface i at displacements q, in the general form (measurements and
 /// set-up: energies, the static start's U_c; the step reads the compact form).
 cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i);
-
-/// The wrench (force, moment) that a node's interfaces exert on it, summed over its interface ends in the
-/// fixed CSR order (so it does not depend on the thread count); onB as computeForcesForInterfacesOfSlice left
-/// it for the node's slice, whose first interface is `firstIface`.
-void gatherInterfaceWrench(const Operators& ops, int node, const cohesive::Vec3* onB, int firstIface, Vec3& force,
-                           Vec3& moment);
-
 /// f_iface (eq. 8): internal force vector of all interfaces for displacements q, slice by slice: the forces of
-/// a slice's interfaces (computeForcesForInterfacesOfSlice), then f = -(the wrench on each of its nodes)
-/// (gatherInterfaceWrench); f is resized to the DOFs. lambdaMax is updated only when `update` (a trial
+/// a slice's interfaces and their wrench on each of its nodes (addInterfaceWrenchesOfSlice), f = -(that
+/// wrench); f is resized to the DOFs. lambdaMax is updated only when `update` (a trial
 /// evaluation leaves the history untouched). Returns the number of failed interfaces.
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, VecX& f);

@@ -11,8 +11,8 @@ namespace enamel {
 // split's layout: for k = 0, 1, 2 with column i = kInPlaneDofs[k] and column o = kOutOfPlaneDofs[k], the pairs
 // (B(0, i), B(1, i)), (B(2, o), B(3, o)), (B(4, o), B(5, i)): rows 0-1 and 5 take the in-plane columns, rows
 // 2-4 the out-of-plane ones, each in ascending column order. Empty when some block couples the groups.
-std::vector<double> splitBlocks(const std::vector<double>& values) {
-  std::vector<double> split;
+std::vector<DoublePair> splitBlocks(const std::vector<double>& values) {
+  std::vector<DoublePair> split;
   for (std::size_t v = 0; 36 * v < values.size(); ++v) {
     auto B = [&](int i, int j) { return values[36 * v + 6 * j + i]; };
     for (int i : kInPlaneDofs)
@@ -20,7 +20,7 @@ std::vector<double> splitBlocks(const std::vector<double>& values) {
         if (B(i, j) != 0.0 || B(j, i) != 0.0) return {};
     for (int k = 0; k < 3; ++k) {
       const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
-      split.insert(split.end(), {B(0, i), B(1, i), B(2, o), B(3, o), B(4, o), B(5, i)});
+      split.insert(split.end(), {DoublePair{B(0, i), B(1, i)}, DoublePair{B(2, o), B(3, o)}, DoublePair{B(4, o), B(5, i)}});
     }
   }
   return split;
@@ -55,6 +55,8 @@ NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
     B.start.push_back(static_cast<int>(B.column.size()));
   }
   B.split = splitBlocks(B.values);
+  if (!B.split.empty())
+    for (int v : B.valueOf) B.splitAt.push_back(9 * v);
   return B;
 }
 

@@ -5,6 +5,9 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace enamel {
 
@@ -28,8 +31,10 @@ struct NodeBlockMatrix {
   std::vector<double> values;  // distinct blocks, column-major: block v, entry (i, j) at values[36 v + 6 j + i]
   // When every block is zero between the in-plane DOFs (ux, uy, rz) and the out-of-plane ones (uz, rx, ry), as
   // for rods that lie in xy-planes: the 18 entries that can be non-zero, per distinct block, in the order of
-  // the product's pairs (multiplyBlockRowSplit); empty otherwise.
-  std::vector<double> split;
+  // the product's pairs (multiplyBlockRowSplit), as 9 aligned pairs; empty otherwise. splitAt: each block's
+  // first pair in `split` (9 x valueOf).
+  std::vector<DoublePair> split;
+  std::vector<int> splitAt;
 };
 
 // The two DOF groups of a node that an in-plane rod's stiffness never couples, each in ascending order.
@@ -37,7 +42,7 @@ constexpr int kInPlaneDofs[3] = {0, 1, 5}, kOutOfPlaneDofs[3] = {2, 3, 4};
 
 // The 18 entries of each distinct block that can be non-zero, in multiplyBlockRowSplit's order (the layout:
 // node_blocks.cpp); empty when some block couples the in-plane and out-of-plane DOFs.
-std::vector<double> splitBlocks(const std::vector<double>& values);
+std::vector<DoublePair> splitBlocks(const std::vector<double>& values);
 
 // K (row-major, whole 6 x 6 blocks on node boundaries) in node blocks, with `split` filled when it applies.
 // Throws SolverError when K is not made of whole node blocks.
@@ -61,30 +66,61 @@ inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, 
   y2 = s2;
 }
 
-// multiplyBlockRow for blocks that do not couple the in-plane and out-of-plane DOFs (K.split not empty): the
-// 18 entries that can be non-zero instead of 36, three pairs of rows at a time, rows (4, 5) paired across the
-// groups. Every row adds the same products in the same (ascending column) order as multiplyBlockRow, and the
-// products it leaves out are exact zeros, so the result is multiplyBlockRow's (up to the sign of a zero).
-inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
-                                  Vec6& y2) {
+namespace detail {
+// (x0, x0) and (x1, x1) of a pair (x0, x1): one SSE2 shuffle each where there is SSE2
+inline DoublePair lowOf(DoublePair a) {
+#if defined(__SSE2__)
+  return reinterpret_cast<DoublePair>(_mm_shuffle_epi32(reinterpret_cast<__m128i>(a), 0x44));
+#else
+  return DoublePair{a[0], a[0]};
+#endif
+}
+inline DoublePair highOf(DoublePair a) {
+#if defined(__SSE2__)
+  return reinterpret_cast<DoublePair>(_mm_shuffle_epi32(reinterpret_cast<__m128i>(a), 0xEE));
+#else
+  return DoublePair{a[1], a[1]};
+#endif
+}
+
+// s += one block's 18 entries B (9 pairs) times the node's six values a (three aligned pairs), rows paired
+// (0, 1), (2, 3), (4, 5): for k = 0, 1, 2 the in-plane column i = kInPlaneDofs[k] and the out-of-plane column
+// o = kOutOfPlaneDofs[k], so each row adds its products in ascending column order.
+[[gnu::always_inline]] inline void addSplitBlock(const DoublePair* B, const DoublePair* a, DoublePair* s) {
+  const DoublePair a01 = a[0], a23 = a[1], a45 = a[2];
+  s[0] += B[0] * lowOf(a01), s[1] += B[1] * lowOf(a23), s[2] += B[2] * DoublePair{a23[0], a01[0]};
+  s[0] += B[3] * highOf(a01), s[1] += B[4] * highOf(a23), s[2] += B[5] * DoublePair{a23[1], a01[1]};
+  s[0] += B[6] * highOf(a45), s[1] += B[7] * lowOf(a45), s[2] += B[8] * a45;
+}
+}  // namespace detail
+
+// multiplyBlockRow for blocks that do not couple the in-plane and out-of-plane DOFs (K.split not empty), into
+// pairs (y[0] = rows 0-1, y[1] = rows 2-3, y[2] = rows 4-5): the 18 entries that can be non-zero instead of
+// 36, three pairs of rows at a time, rows (4, 5) paired across the groups; x1 and x2 16-byte aligned (Eigen's
+// vectors are). Every row adds the same products in the same (ascending column) order as multiplyBlockRow,
+// and the products it leaves out are exact zeros, so the result is multiplyBlockRow's (up to the sign of a
+// zero). One vector at a time: three accumulators and a block's pairs stay in the 16 SSE2 registers.
+inline void multiplyBlockRowSplitPairs(const NodeBlockMatrix& K, int R, const double* x1, const double* x2,
+                                       DoublePair* y1, DoublePair* y2) {
   using Pair = DoublePair;
-  // one vector at a time: three accumulators and the block's pairs stay in the 16 SSE2 registers
-  auto product = [&](const double* x, Vec6& y) {
-    Pair s01 = {0, 0}, s23 = {0, 0}, s45 = {0, 0};
-    for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
-      const double* B = K.split.data() + 18 * static_cast<std::size_t>(K.valueOf[b]);
-      const double* a = x + 6 * K.column[b];
-      for (int k = 0; k < 3; ++k, B += 6) {
-        const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
-        s01 += Pair{B[0], B[1]} * Pair{a[i], a[i]};
-        s23 += Pair{B[2], B[3]} * Pair{a[o], a[o]};
-        s45 += Pair{B[4], B[5]} * Pair{a[o], a[i]};
-      }
-    }
-    y << s01[0], s01[1], s23[0], s23[1], s45[0], s45[1];
+  const Pair* split = K.split.data();
+  auto product = [&](const double* x, Pair* y) {
+    const Pair* a = static_cast<const Pair*>(__builtin_assume_aligned(x, 16));
+    Pair s[3] = {{0, 0}, {0, 0}, {0, 0}};
+    for (int b = K.start[R]; b < K.start[R + 1]; ++b) detail::addSplitBlock(split + K.splitAt[b], a + 3 * K.column[b], s);
+    y[0] = s[0], y[1] = s[1], y[2] = s[2];
   };
   product(x1, y1);
   product(x2, y2);
+}
+
+// multiplyBlockRowSplitPairs into 6-vectors.
+inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
+                                  Vec6& y2) {
+  DoublePair p1[3], p2[3];
+  multiplyBlockRowSplitPairs(K, R, x1, x2, p1, p2);
+  y1 << p1[0][0], p1[0][1], p1[1][0], p1[1][1], p1[2][0], p1[2][1];
+  y2 << p2[0][0], p2[0][1], p2[1][0], p2[1][1], p2[2][0], p2[2][1];
 }
 
 }  // namespace enamel

@@ -177,7 +177,7 @@ void indexSlices(const Model& m, Operators& ops) {
     ops.ifacePacked.push_back(cohesive::packInSlice(m.ifaceGeom[i]));
   }
   for (int k = 0; k < m.numSlices; ++k) {
-    ops.maxIfacesPerSlice = std::max(ops.maxIfacesPerSlice, ops.sliceIfaceStart[k + 1]);
+    ops.maxNodesPerSlice = std::max(ops.maxNodesPerSlice, ops.sliceNodeStart[k + 1]);
     ops.sliceNodeStart[k + 1] += ops.sliceNodeStart[k];
     ops.sliceIfaceStart[k + 1] += ops.sliceIfaceStart[k];
   }

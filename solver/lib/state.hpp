@@ -74,14 +74,15 @@ struct Operators {
   std::vector<int> freeDofs;
   std::vector<int> dofToFree;                    // index into freeDofs; -1 for prescribed
   std::vector<std::array<int, 2>> cutBeamNodes;  // nodes of the rod elements cut by the pre-crack
-  // Interface adjacency (node -> interface ends) for a deterministic gather of interface forces.
+  // Interface adjacency (node -> interface ends, in ascending interface order; the kernels add each
+  // interface's wrench to its nodes in that order).
   std::vector<int> nodeIfaceStart, nodeIfaceList;  // CSR; entries are 2*iface + side (0 = A, 1 = B)
   // The slices (geometry.hpp numbers nodes slice by slice, and builds interfaces slice by slice): the nodes
   // of slice k are sliceNodeStart[k] .. sliceNodeStart[k+1] - 1, its interfaces likewise; an interface joins
   // two nodes of its own slice. The force kernels work slice by slice, on data that stays in cache.
   std::vector<int> sliceNodeStart, sliceIfaceStart;
   std::vector<cohesive::SliceInterface> ifacePacked;  // Model::ifaceGeom in the compact form the kernels read
-  int maxIfacesPerSlice = 0;
+  int maxNodesPerSlice = 0;
 };
 
 /// Everything that changes during a run (checkpointable: checkpoint.cpp lists every field once).
