@@ -148,18 +148,39 @@ SliceInterface packInSlice(const InterfaceGeometry& g) {
   return SliceInterface{n.y(), n.z(), g.armA.y(), g.armA.z(), g.armB.y(), g.armB.z(), g.area};
 }
 
-// delta = (uB + thB x rB) - (uA + thA x rA) with r = (0, ry, rz): thB x rB = (thy rz - thz ry, -thx rz, thx ry);
-// local opening (n . delta, delta_x, t2 . delta) with t2 = (0, nz, -ny); F_B = -A (n t_n + e_x t_1 + t2 t_2).
-// Every product the general form multiplies by an exact zero is left out: the sums keep their order, so the
-// result is the general form's bit for bit (a zero product adds nothing exactly, without FMA contraction).
-Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA,
-                              const Vec3& uB, const Vec3& thB, double& lambdaMax) {
+// delta = (uB + thB x rB) - (uA + thA x rA) with r = (0, ry, rz): thB x rB = (thy rz - thz ry, -thx rz, thx ry)
+// (the products the general form multiplies by the arms' zero x left out).
+Vec3 computeOpening(const SliceInterface& g, const Vec3& uA, const Vec3& thA, const Vec3& uB, const Vec3& thB) {
   const double ox = (uB.x() + (thB.y() * g.armBz - thB.z() * g.armBy)) - (uA.x() + (thA.y() * g.armAz - thA.z() * g.armAy));
   const double oy = (uB.y() + (-(thB.x() * g.armBz))) - (uA.y() + (-(thA.x() * g.armAz)));
   const double oz = (uB.z() + thB.x() * g.armBy) - (uA.z() + thA.x() * g.armAy);
-  const Vec3 openingLocal(g.ny * oy + g.nz * oz, ox, g.nz * oy + (-g.ny) * oz);
-  const Vec3 t = computeTraction(law, openingLocal, lambdaMax);
+  return Vec3(ox, oy, oz);
+}
+
+// local opening (n . delta, delta_x, t2 . delta) with t2 = (0, nz, -ny)
+Vec3 localOpening(const SliceInterface& g, const Vec3& opening) {
+  return Vec3(g.ny * opening.y() + g.nz * opening.z(), opening.x(), g.nz * opening.y() + (-g.ny) * opening.z());
+}
+
+// F_B = -A (n t_n + e_x t_1 + t2 t_2)
+Vec3 forceOnBOfTraction(const SliceInterface& g, const Vec3& t) {
   return -g.area * Vec3(t(1), g.ny * t(0) + g.nz * t(2), g.nz * t(0) + (-g.ny) * t(2));
+}
+
+// The opening, its local form, the traction and the force as above. Every product the general form multiplies
+// by an exact zero is left out: the sums keep their order, so the result is the general form's bit for bit (a
+// zero product adds nothing exactly, without FMA contraction).
+Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA,
+                              const Vec3& uB, const Vec3& thB, double& lambdaMax) {
+  const Vec3 t = computeTraction(law, localOpening(g, computeOpening(g, uA, thA, uB, thB)), lambdaMax);
+  return forceOnBOfTraction(g, t);
+}
+
+// t = k R delta in every direction while S = k (tension, shear and contact alike), so F_B = -A R^T k R delta
+// = -k A delta (R orthonormal).
+Vec3 elasticForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA, const Vec3& uB,
+                     const Vec3& thB) {
+  return -(law.k * g.area) * computeOpening(g, uA, thA, uB, thB);
 }
 
 // B: (F_B, rB x F_B);  A: F_A = -F_B, (F_A, rA x F_A)

@@ -105,10 +105,22 @@ struct SliceInterface {
 // arm with an x part, or a frame other than makeFrame's for that normal).
 SliceInterface packInSlice(const InterfaceGeometry& g);
 
+// The compact form's pieces: the opening in the global frame (computeOpening), its local components (n, t1,
+// t2) (frame * opening), and the force on B of a local traction t (-area frame^T t).
+Vec3 computeOpening(const SliceInterface& g, const Vec3& uA, const Vec3& thA, const Vec3& uB, const Vec3& thB);
+Vec3 localOpening(const SliceInterface& g, const Vec3& opening);
+Vec3 forceOnBOfTraction(const SliceInterface& g, const Vec3& t);
+
 // computeInterfaceForceOnB for the compact form (the code the solver runs): the same opening, traction and
 // force, written out for the known zeros of the frame and the arms; equal to the general form bit for bit.
 Vec3 computeInterfaceForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA,
                               const Vec3& uB, const Vec3& thB, double& lambdaMax);
+
+// The force on B while the interface is on the elastic branch (secantStiffness(law, lambdaMax) = k): the
+// traction is k times the local opening in every direction, contact included, so F_B = -k area opening, linear
+// in the DOFs; computeInterfaceForceOnB's value there up to round-off (the frame's rotations left out).
+Vec3 elasticForceOnB(const Law& law, const SliceInterface& g, const Vec3& uA, const Vec3& thA, const Vec3& uB,
+                     const Vec3& thB);
 
 // wrenchOnSide for the compact form.
 Wrench wrenchOnSide(const SliceInterface& g, const Vec3& forceOnB, bool sideB);

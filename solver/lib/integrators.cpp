@@ -275,7 +275,10 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 //   2 / omega_max (sqrt(1 + xi^2) - xi), xi = b' omega_max / 2.
 // One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first:
 //   f_iface(q_n), K q_n, K v_{n-1/2}                      (forces for interfaces, for beams; the interfaces'
-//                                                          history is updated here, at q_n)
+//                                                          history is updated here, at q_n; an elastic
+//                                                          interface's force is linear, and the law sees
+//                                                          only those that could leave the elastic track:
+//                                                          InterfaceSchedule, kernels.hpp)
 //   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface - b' K v_{n-1/2})] / (1 + a dt/2)
 //   v_{n+1/2} of the grips = shape V(t_n + dt/2)          (velocities, boundary condition on them)
 //   R_p = (K q + f_iface + b' K v_{n-1/2} + M (a_p + a v_p))_p at t_n, with the grips' a_p and v_p by central
@@ -352,11 +355,14 @@ class LumpedIntegrator : public Integrator {
     const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
     moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
+    largestValue_ = std::max(move.largestValue, largestShape_ * std::abs(s.appliedDisplacement));  // >= max |q_{n+1}|
   }
 
   double lastStepMoveBound() const override { return moveBound_; }
+  const InterfaceSchedule* interfaceSchedule() const override { return &ifaceSchedule_; }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    moveBound_ = INFINITY;  // q set from outside the step (the static start): the interface schedule starts afresh
     applyBoundaryConditions(ops, mat.loading, dt_, s);
     computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, false, fI_);
     const VecX acc = -invMass_.cwiseProduct(fI_ + ops.K * s.q + bEff_ * (ops.K * s.v)) - dampA_ * s.v;
@@ -385,12 +391,16 @@ class LumpedIntegrator : public Integrator {
 
   // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a
   // slice in a fixed order, so nothing depends on the thread count). Per slice:
-  //   the wrench of its interfaces on its nodes (opening, law, force on B; their history updated at q_n)
+  //   the wrench of its interfaces on its nodes: the elastic force of those the law need not see
+  //     (InterfaceSchedule, kernels.hpp), the law's (opening, law, force on B) of the others, their history
+  //     updated at q_n
   //   per node (advanceVelocityOfNode): K q_n and K v_{n-1/2} (its block row), r = K q + f_iface + b' K v,
   //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
   //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
   //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
-  // v_{n+1/2} goes to vNext_ (K v_{n-1/2} of the next slice still reads v_{n-1/2}) and replaces v at the end.
+  //   q_{n+1} = q_n + dt v_{n+1/2}, and the slice's share of its maxima max |dt v|, max |q_{n+1}|
+  // v_{n+1/2} and q_{n+1} go to vNext_ and qNext_ (K q_n, K v_{n-1/2} of the next slice still read q_n and
+  // v_{n-1/2}) and replace them once the step's other parts are done (advancePositions).
   // Returns the number of failed interfaces.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
     const cohesive::Law law = mat.law;
@@ -401,34 +411,42 @@ class LumpedIntegrator : public Integrator {
     step.b = bEff_;
     step.Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
     vNext_.resize(s.vHalf.size());
-    sliceWorkM_.assign(m.numSlices, 0.0);
-    sliceWorkK_.assign(m.numSlices, 0.0);
+    qNext_.resize(s.q.size());
+    sliceSums_.assign(m.numSlices, SliceSums{});
     const double* q = s.q.data();
     double* lambda = s.lambdaMax.data();
+    advanceInterfaceSchedule(m, law, ops, moveBound_, largestValue_, ifaceSchedule_);
     int failed = 0;
-#pragma omp parallel reduction(+ : failed) firstprivate(law, q, lambda, step)
+    long evaluated = 0;
+#pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
       for (int k = 0; k < m.numSlices; ++k) {
-        failed += addInterfaceWrenchesOfSlice(m, law, ops, k, q, lambda, true, wrench.data());
-        double work[2] = {0, 0};
+        failed += addInterfaceWrenchesOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
+        SliceSums sums;
         const int firstNode = ops.sliceNodeStart[k];
         for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-          advanceVelocityOfNode(ops, step, node, q, s.vHalf.data(), wrench.data() + 6 * (node - firstNode), work);
-        sliceWorkM_[k] = work[0];
-        sliceWorkK_[k] = work[1];
+          advanceNode(ops, step, node, q, s.vHalf.data(), wrench.data() + 6 * (node - firstNode), sums);
+        sliceSums_[k] = sums;
       }
     }
+    ifaceSchedule_.evaluated = evaluated;
     return failed;
   }
 
+  // A slice's share of the damping work's two sums, and of the position update's maxima (pairs).
+  struct SliceSums {
+    double workM = 0, workK = 0;
+    DoublePair largestStep = {0, 0}, largestValue = {0, 0};
+  };
+
   // One node's v_{n+1/2} into vNext_ from its block row of K times q and v (= v_{n-1/2}) and the wrench of its
-  // interfaces W (f_iface = -W, so r = K q - W + b' K v); work[0] += v.Mv, work[1] += v.Kv over its DOFs in
-  // order. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
-  [[gnu::always_inline]] inline void advanceVelocityOfNode(const Operators& ops, const NodeStep& c, int node,
-                                                           const double* q, const double* v, const double* W,
-                                                           double* work) {
+  // interfaces W (f_iface = -W, so r = K q - W + b' K v), and its q_{n+1} = q_n + dt v_{n+1/2} into qNext_
+  // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv over its DOFs in order, max |dt v| and
+  // max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
+  [[gnu::always_inline]] inline void advanceNode(const Operators& ops, const NodeStep& c, int node, const double* q,
+                                                 const double* v, const double* W, SliceSums& sums) {
     using Pair = DoublePair;
     const NodeBlockMatrix& K = Kblocks_;
     Pair Kq[3], Kv[3];
@@ -454,15 +472,24 @@ class LumpedIntegrator : public Integrator {
         vn[j / 2][j % 2] = ops.prescribedShape[grip] * c.Vgrip;
         gripResidual_[grip] = r[j / 2][j % 2];
       }
-    Pair* out = static_cast<Pair*>(__builtin_assume_aligned(vNext_.data() + 6 * node, 16));
-    double workM = work[0], workK = work[1];
+    auto out = [node](VecX& x) { return static_cast<Pair*>(__builtin_assume_aligned(x.data() + 6 * node, 16)); };
+    auto absMax = [](Pair m, Pair a) {
+      const Pair mag = a < 0 ? -a : a;
+      return mag > m ? mag : m;
+    };
+    Pair *vOut = out(vNext_), *qOut = out(qNext_);
+    const Pair* qNode = pairs(q);
+    double workM = sums.workM, workK = sums.workK;
     for (int j = 0; j < 3; ++j) {
-      out[j] = vn[j];
+      vOut[j] = vn[j];
       const Pair m = vn[j] * (mass[j] * vn[j]), k = vn[j] * Kv[j];
       workM += m[0], workK += k[0];
       workM += m[1], workK += k[1];
+      const Pair stepj = Pair{c.dt, c.dt} * vn[j], y = qNode[j] + stepj;
+      qOut[j] = y;
+      sums.largestStep = absMax(sums.largestStep, stepj), sums.largestValue = absMax(sums.largestValue, y);
     }
-    work[0] = workM, work[1] = workK;
+    sums.workM = workM, sums.workK = workK;
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
@@ -480,14 +507,20 @@ class LumpedIntegrator : public Integrator {
   // W_damp += dt (a v_{n+1/2} . M v_{n+1/2} + b' v_{n+1/2} . K v_{n-1/2}), the sums in slice order
   void addDampingWork(State& s) const {
     double sumM = 0, sumK = 0;
-    for (std::size_t k = 0; k < sliceWorkM_.size(); ++k) { sumM += sliceWorkM_[k]; sumK += sliceWorkK_[k]; }
+    for (const SliceSums& k : sliceSums_) { sumM += k.workM; sumK += k.workK; }
     s.dampingWork += dt_ * (dampA_ * sumM + bEff_ * sumK);
   }
 
-  // v_{n+1/2} replaces v_{n-1/2};  q_{n+1} = q_n + dt v_{n+1/2}
+  // v_{n+1/2} replaces v_{n-1/2} and q_{n+1} = q_n + dt v_{n+1/2} (both computed in the node pass) replaces q_n
   PositionMove advancePositions(State& s) {
     s.vHalf.swap(vNext_);
-    return enamel::advancePositions(s.q, s.vHalf, dt_);
+    s.q.swap(qNext_);
+    PositionMove move;
+    for (const SliceSums& k : sliceSums_) {  // maxima: exact in any order
+      move.largestStep = std::max({move.largestStep, k.largestStep[0], k.largestStep[1]});
+      move.largestValue = std::max({move.largestValue, k.largestValue[0], k.largestValue[1]});
+    }
+    return move;
   }
 
   // max_i |q_{n+1,i} - q_{n,i}|: a free DOF moved by fl(q + dt v) - q, at most |dt v| plus half an ulp of the
@@ -501,11 +534,13 @@ class LumpedIntegrator : public Integrator {
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
   double largestShape_ = 0;          // max |shape| of the prescribed DOFs
-  double moveBound_ = INFINITY;      // lastStepMoveBound
-  VecX mass_, invMass_, fI_, vNext_, vGripBefore_, vGrip_, gripResidual_;
+  double moveBound_ = INFINITY;      // lastStepMoveBound (infinite: q was set otherwise, the schedules start afresh)
+  double largestValue_ = INFINITY;   // a bound on max |q_n|
+  InterfaceSchedule ifaceSchedule_;  // which interfaces the law must see (kernels.hpp)
+  VecX mass_, invMass_, fI_, vNext_, qNext_, vGripBefore_, vGrip_, gripResidual_;
   std::vector<int> gripOfDof_;                 // index into ops.prescribedDofs; -1 for a free DOF
   std::vector<std::uint8_t> nodeHasGrip_;      // per node: 1 when one of its DOFs is prescribed
-  std::vector<double> sliceWorkM_, sliceWorkK_;  // each slice's share of the damping work's two sums
+  std::vector<SliceSums> sliceSums_;  // per slice
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
 };
 

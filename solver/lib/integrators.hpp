@@ -8,6 +8,7 @@
 
 #include "case_params.hpp"
 #include "errors.hpp"  // IntegratorError, SolverError (kept here for the files that include them through this one)
+#include "kernels.hpp"  // InterfaceSchedule
 #include "state.hpp"
 
 namespace enamel {
@@ -42,6 +43,9 @@ class Integrator {
   /// A bound on how far any DOF moved in the last step, max_i |q_i(t_{n+1}) - q_i(t_n)| (round-off included);
   /// infinite when the scheme gives none (then the deletion check computes every rod element).
   virtual double lastStepMoveBound() const { return INFINITY; }
+  /// The schedule of the interface law the step keeps (`lumped`, kernels.hpp InterfaceSchedule; its `evaluated`:
+  /// the last step's count); null when the scheme evaluates every interface at every step.
+  virtual const InterfaceSchedule* interfaceSchedule() const { return nullptr; }
   /// One line on the scheme's own choices (mass scaling, damping), for the output's provenance.
   virtual std::string describe() const { return name(); }
 };

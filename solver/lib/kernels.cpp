@@ -78,6 +78,18 @@ namespace {
 [[gnu::always_inline]] inline void addWrench(double* w, const cohesive::Wrench& e) {
   for (int c = 0; c < 3; ++c) w[c] += e.force[c], w[3 + c] += e.moment[c];
 }
+
+// addWrench of both ends, A then B, from the force on B, written out: wA -= (F_B, rA x F_B), wB += (F_B, rB x F_B),
+// which is adding cohesive::wrenchOnSide's (F_A, rA x F_A) with F_A = -F_B (a + (-b) = a - b, and
+// (-x) - (-y) = -(x - y), exactly), in six scalar sums per end.
+[[gnu::always_inline]] inline void addWrenchesOfForce(const cohesive::SliceInterface& g, const cohesive::Vec3& F,
+                                                      double* wA, double* wB) {
+  const double fx = F.x(), fy = F.y(), fz = F.z();
+  wA[0] -= fx, wA[1] -= fy, wA[2] -= fz;
+  wA[3] -= g.armAy * fz - g.armAz * fy, wA[4] -= g.armAz * fx, wA[5] += g.armAy * fx;
+  wB[0] += fx, wB[1] += fy, wB[2] += fz;
+  wB[3] += g.armBy * fz - g.armBz * fy, wB[4] += g.armBz * fx, wB[5] += -(g.armBy * fx);
+}
 }  // namespace
 
 // Per interface: its force on B (the compact form's opening, law and force), then the wrench on A and on B
@@ -104,6 +116,100 @@ namespace {
     addWrench(wrench + 6 * (A - firstNode), cohesive::wrenchOnSide(packed[i], F, false));
     addWrench(wrench + 6 * (B - firstNode), cohesive::wrenchOnSide(packed[i], F, true));
   }
+  return failed;
+}
+
+namespace {
+// c of InterfaceSchedule: a bound on |lambda change| / |q change|_inf
+double separationRate(const cohesive::SliceInterface& g) {
+  return std::sqrt(3.0) * (2.0 + std::abs(g.armAy) + std::abs(g.armAz) + std::abs(g.armBy) + std::abs(g.armBz));
+}
+
+double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElasticTrack) * law.delta0(); }
+
+// A due interface: the law at its opening (history updated), the force it exerts (elastic while the secant
+// stiffness is k) and the drift from which it is due again.
+[[gnu::noinline]] cohesive::Vec3 evaluateDueInterface(const cohesive::Law& law, const cohesive::SliceInterface& g,
+                                                     const double* qA, const double* qB, double drift,
+                                                     double& lambdaMax, double& due, int& failed) {
+  using Map3 = Eigen::Map<const cohesive::Vec3>;
+  const Map3 uA(qA), thA(qA + 3), uB(qB), thB(qB + 3);
+  const cohesive::Vec3 opening = cohesive::localOpening(g, cohesive::computeOpening(g, uA, thA, uB, thB));
+  const cohesive::Vec3 t = cohesive::computeTraction(law, opening, lambdaMax);
+  failed += cohesive::isFailed(law, lambdaMax);
+  if (cohesive::secantStiffness(law, lambdaMax) != law.k) {
+    due = drift;  // off the elastic branch: the law at every step
+    return cohesive::forceOnBOfTraction(g, t);
+  }
+  const double room = (1.0 - kInterfaceScheduleMargin) * lambdaTrack(law) - cohesive::effectiveSeparation(opening);
+  due = room > 0 ? drift + room / separationRate(g) : drift;  // (a NaN opening: due again)
+  return cohesive::elasticForceOnB(law, g, uA, thA, uB, thB);
+}
+}  // namespace
+
+void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Operators& ops, double moved,
+                              double largestValue, InterfaceSchedule& schedule) {
+  if (!std::isfinite(moved) || static_cast<int>(schedule.due.size()) != m.numInterfaces()) {
+    schedule.drift = 0;
+    schedule.due.assign(m.numInterfaces(), 0.0);
+    schedule.largestRate = 0;
+    for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(g));
+  } else {
+    schedule.drift += moved * (1.0 + 1e-6);  // the 1e-6 covers the round-off of this running sum
+  }
+  const double roundOff = 32.0 * std::numeric_limits<double>::epsilon() * schedule.largestRate * largestValue;
+  const bool small = roundOff <= 0.25 * kInterfaceScheduleMargin * lambdaTrack(law);  // false for a NaN
+  schedule.dueBelow = small ? schedule.drift : INFINITY;
+}
+
+[[gnu::flatten]] int addInterfaceWrenchesOfSliceScheduled(const Model& m, const cohesive::Law& lawGiven,
+                                                          const Operators& ops, int k, const double* q,
+                                                          double* lambdaMax, InterfaceSchedule& schedule,
+                                                          double* wrench, long& evaluated) {
+  const cohesive::Law law = lawGiven;  // a local copy, as in addInterfaceWrenchesOfSlice
+  int failed = 0;
+  const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1], firstNode = ops.sliceNodeStart[k];
+  std::fill(wrench, wrench + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
+  const auto* nodes = m.ifaceNodes.data();
+  const cohesive::SliceInterface* packed = ops.ifacePacked.data();
+  double* due = schedule.due.data();
+  const double drift = schedule.drift, dueBelow = schedule.dueBelow;
+  using Map3 = Eigen::Map<const cohesive::Vec3>;
+  for (int i = first; i < last; ++i) {
+    const int A = nodes[i][0], B = nodes[i][1];
+    const double *qA = q + 6 * A, *qB = q + 6 * B;
+    cohesive::Vec3 F;
+    if (due[i] <= dueBelow) {
+      F = evaluateDueInterface(law, packed[i], qA, qB, drift, lambdaMax[i], due[i], failed);
+      ++evaluated;
+    } else {
+      F = cohesive::elasticForceOnB(law, packed[i], Map3(qA), Map3(qA + 3), Map3(qB), Map3(qB + 3));
+    }
+    addWrenchesOfForce(packed[i], F, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+  }
+  return failed;
+}
+
+// Not inlined: the profile's "interfaces" kernel, which bench/step_instructions.py finds by its name.
+[[gnu::noinline]] int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law,
+                                                          const Operators& ops, const VecX& q,
+                                                          std::vector<double>& lambdaMax,
+                                                          InterfaceSchedule& schedule, VecX& f) {
+  f.resize(m.numDofs());
+  int failed = 0;
+  long evaluated = 0;
+#pragma omp parallel reduction(+ : failed, evaluated)
+  {
+    std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
+#pragma omp for schedule(static)
+    for (int k = 0; k < m.numSlices; ++k) {
+      failed += addInterfaceWrenchesOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(), schedule,
+                                                     wrench.data(), evaluated);
+      const int firstNode = ops.sliceNodeStart[k];
+      for (int dof = 6 * firstNode; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) f[dof] = -wrench[dof - 6 * firstNode];
+    }
+  }
+  schedule.evaluated = evaluated;
   return failed;
 }
 
@@ -137,7 +243,8 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 }
 
 // --- positions ---------------------------------------------------------------------------------------
-PositionMove advancePositions(VecX& q, const VecX& v, double dt) {
+// Not inlined: the profile times it alone, and bench/step_instructions.py finds it by its name.
+[[gnu::noinline]] PositionMove advancePositions(VecX& q, const VecX& v, double dt) {
   // Two DOFs at a time with the maxima in three independent pairs per block of six (a maximum is exact, so
   // the result equals the one-at-a-time loop's whatever the grouping or the thread count); the same
   // q + dt v per DOF.

@@ -40,6 +40,44 @@ cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i);
 int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const Operators& ops, const VecX& q,
                                std::vector<double>& lambdaMax, bool update, VecX& f);
 
+/// The lumped step's schedule of the interface law. An interface on the elastic branch (secantStiffness = k)
+/// exerts cohesive::elasticForceOnB, linear in its DOFs; the law (cohesive::computeTraction) is needed only to
+/// notice it leave its elastic track (cohesive.hpp), and it cannot while its effective separation lambda stays
+/// below (1 - kInterfaceScheduleMargin) lambdaTrack (lambdaTrack = sqrt(kElasticTrack) delta0). lambda moves by
+/// at most c |q change|_inf, c = sqrt(3) (2 + |rA,y| + |rA,z| + |rB,y| + |rB,z|) (lambda is 1-Lipschitz in the
+/// opening, whose components each move by at most their row's sum of |coefficients| times |q change|_inf): so
+/// an interface whose lambda was computed when the displacements' drift (as in StressCheckSchedule) stood at D
+/// need not see the law before the drift reaches D + ((1 - margin) lambdaTrack - lambda) / c. Every other
+/// interface (due, or off the elastic branch) is evaluated by the law at every step, exactly as without the
+/// schedule: the histories, and so which interfaces are elastic, are the same, and the force of an interface
+/// depends only on q and its history (elasticForceOnB while elastic, the law's otherwise), never on the
+/// schedule: a fresh schedule (a restart) gives the same numbers. Scratch, not part of State.
+inline constexpr double kInterfaceScheduleMargin = 1e-4;
+struct InterfaceSchedule {
+  double drift = 0;           // bound on how far any DOF moved since the schedule started
+  double dueBelow = 0;        // this pass evaluates the interfaces with due <= dueBelow (drift, or all of them)
+  double largestRate = 0;     // max over interfaces of c
+  std::vector<double> due;    // per interface: the drift from which the law must see it again
+  long evaluated = 0;         // interfaces the last pass evaluated by the law
+};
+/// Before a pass at displacements that moved by at most `moved` (max over DOFs; infinite: start afresh) since the
+/// last one, with max |q| = `largestValue`: a fresh schedule (every interface due) when it has none of the
+/// model's size or `moved` is not finite; all due this pass (without restarting) when the round-off of an
+/// opening, 32 eps c |q|_inf, could reach a quarter of the margin, kInterfaceScheduleMargin lambdaTrack / 4.
+void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Operators& ops, double moved,
+                              double largestValue, InterfaceSchedule& schedule);
+/// addInterfaceWrenchesOfSlice with the schedule (the lumped step's pass, lambdaMax always updated): an
+/// interface not due exerts cohesive::elasticForceOnB; a due one is evaluated by the law (history updated), and
+/// exerts elasticForceOnB while elastic, the law's force otherwise, and gets its next due drift. Adds the
+/// interfaces evaluated to `evaluated`; returns the number of failed interfaces of the slice.
+int addInterfaceWrenchesOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
+                                         const double* q, double* lambdaMax, InterfaceSchedule& schedule,
+                                         double* wrench, long& evaluated);
+/// f_iface by addInterfaceWrenchesOfSliceScheduled over all slices (the profile and the tests; the lumped step
+/// runs the slice pass inside its own). Returns the number of failed interfaces.
+int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
+                                        const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule,
+                                        VecX& f);
 /// What a position update moved: the largest |dt v_i| added and the largest |q_i| after it.
 struct PositionMove {
   double largestStep = 0, largestValue = 0;

@@ -59,18 +59,17 @@ std::string percent(double fraction) {
   return buf;
 }
 
-ByteCounts countBytes(const Model& m, const Operators& ops) {
+ByteCounts countBytes(const Model& m) {
   const double ni = m.numInterfaces(), nn = m.numNodes(), ne = m.numBeams();
-  const double ends = static_cast<double>(ops.nodeIfaceList.size());
   const double blocks = 2.0 * ne + nn;  // K: one diagonal block per node, two off-diagonal per rod element
   ByteCounts b;
-  // per interface: compact geometry (56), its two nodes (8), lambdaMax read and written (16)
-  b.interfaces = ni * (sizeof(cohesive::SliceInterface) + 8 + 16);
-  // the same on their own: also q read, f written and the CSR of interface ends
-  b.interfacesAlone = b.interfaces + nn * (48 + 48 + 4) + 4 * ends;
-  // per node: q and v_{n-1/2} read, v_{n+1/2} written, 1/m and m, the grip map (6 x (8 + 8 + 8 + 8 + 8 + 4));
-  // the interface ends' CSR (4 per end + 4 per node); K's blocks (column and value index, 8 per block + 4 per row)
-  b.nodes = nn * 6 * (8 * 5 + 4) + 4 * (ends + nn) + 8 * blocks + 4 * nn;
+  // per interface: compact geometry (56), its two nodes (8), its due drift (8); the history only where due
+  b.interfaces = ni * (sizeof(cohesive::SliceInterface) + 8 + 8);
+  // the same on their own: also q read and f written
+  b.interfacesAlone = b.interfaces + nn * (48 + 48);
+  // per node: q and v_{n-1/2} read, v_{n+1/2} and q_{n+1} written, 1/m and m (6 x 6 x 8), its grip flag (1);
+  // K's blocks (column and pair index, 8 per block + 4 per row)
+  b.nodes = nn * 6 * 6 * 8 + nn + 8 * blocks + 4 * nn;
   // q read and written, v read
   b.positions = nn * 6 * 24;
   // per rod element: its nodes (8), rod (4), strength (8), broken flag (1), ratio written (8), and one node's q
@@ -84,18 +83,20 @@ ByteCounts countBytes(const Model& m, const Operators& ops) {
 }  // namespace
 
 KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
-  if (sim.integrator->name() != "lumped")
+  if (sim.integrator->name() != "lumped" || !sim.integrator->interfaceSchedule())
     throw IntegratorError("profile: integrator '" + sim.integrator->name() + "' is not profiled (allowed: lumped)");
   KernelProfile p;
   p.threads = threadCount();
   p.steps = steps;
   p.dof = sim.model.numDofs();
   for (long i = 0; i < warmup; ++i) sim.step();
-  const ByteCounts bytes = countBytes(sim.model, sim.ops);
+  const ByteCounts bytes = countBytes(sim.model);
   const Model& m = sim.model;
   State& s = sim.state;
-  VecX f;
-  std::vector<double> ratio;
+  VecX f, qMoved = s.q;
+  std::vector<double> ratio, lambdaTrial;
+  InterfaceSchedule schedule;  // the interfaces kernel's own: a copy of the step's
+  long evaluated = 0;  // interfaces the step's law saw over the timed steps
   // Each kernel timed in kRounds interleaved rounds of steps / kRounds calls, the median round kept: all of
   // them see the machine in the same minutes (this machine's speed varies by up to 2x within an afternoon),
   // and "step - advance" is a difference of neighbours. A round of the whole step begins with one untimed step:
@@ -109,17 +110,28 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
     stepT.push_back(secondsPerCall(perRound, [&] {
       sim.step();
       computed += sim.stressCheckSchedule().computed;
+      evaluated += sim.integrator->interfaceSchedule()->evaluated;
       ++timedSteps;
     }));
     advanceT.push_back(secondsPerCall(perRound, [&] { sim.integrator->advance(m, sim.materials, sim.ops, s); }));
-    interfacesT.push_back(secondsPerCall(
-        perRound, [&] { computeForcesForInterfaces(m, sim.materials.law, sim.ops, s.q, s.lambdaMax, false, f); }));
+    lambdaTrial = s.lambdaMax;  // the kernel's history updates go to a copy
+    schedule = *sim.integrator->interfaceSchedule();  // the step's, as it stands
+    const double qLargest = s.q.cwiseAbs().maxCoeff();
+    interfacesT.push_back(secondsPerCall(perRound, [&] {
+      // as if the step had moved q as far as the last one did
+      advanceInterfaceSchedule(m, sim.materials.law, sim.ops, sim.integrator->lastStepMoveBound(),
+                               qLargest, schedule);
+      computeForcesForInterfacesScheduled(m, sim.materials.law, sim.ops, s.q, lambdaTrial, schedule, f);
+    }));
     checkT.push_back(secondsPerCall(
         perRound, [&] { computeStressRatiosForBeams(m, sim.materials, s.q, s.beamBroken, ratio); }));
+    qMoved = s.q;  // moved on a copy: the step's state (and its schedules' bounds) stay as they were
     positionsT.push_back(
-        secondsPerCall(perRound, [&] { advancePositions(s.q, s.vHalf, sim.integrator->timeStep()); }));
+        secondsPerCall(perRound, [&] { advancePositions(qMoved, s.vHalf, sim.integrator->timeStep()); }));
   }
   p.steps = perRound * kRounds;
+  p.interfaceEvaluatedFraction =
+      static_cast<double>(evaluated) / std::max(1.0, static_cast<double>(timedSteps) * m.numInterfaces());
   p.stressComputedFraction =
       static_cast<double>(computed) / std::max(1.0, static_cast<double>(timedSteps) * m.numBeams());
   const double step = median(stepT), advance = median(advanceT), interfaces = median(interfacesT),
@@ -127,14 +139,16 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
   p.triadBytesPerSecond = measureTriad(3 * static_cast<long>(p.dof));
   p.kernels = {
       {"step", "the whole time step (integrator's advance, rod stress check, crack measure when something failed)",
-       step, bytes.interfaces + bytes.nodes + bytes.positions + bytes.stressSchedule + p.stressComputedFraction * bytes.stressCheck},
-      {"advance", "the integrator's step: the slice pass (interfaces, then nodes) and the position update",
-       advance, bytes.interfaces + bytes.nodes + bytes.positions},
-      {"  interfaces", "per interface: opening, law, force on B; per node its wrench (alone, with f written)",
+       step, bytes.interfaces + bytes.nodes + bytes.stressSchedule + p.stressComputedFraction * bytes.stressCheck},
+      {"advance", "the integrator's step: the slice pass (interfaces, then per node its velocity and position)",
+       advance, bytes.interfaces + bytes.nodes},
+      {"  interfaces", "per interface: its elastic force, or the law's where the schedule makes it due (the step: " +
+       percent(p.interfaceEvaluatedFraction) + " of the interfaces per step), its wrench added to both nodes (alone, with f written)",
        interfaces, bytes.interfacesAlone},
-      {"  nodes", "advance - interfaces - positions: per node K rows, v_{n+1/2}, grip residuals, damping sums",
-       std::max(0.0, advance - interfaces - positions), bytes.nodes},
-      {"  positions", "q += dt v over all DOF", positions, bytes.positions},
+      {"  nodes", "advance - interfaces: per node K rows, v_{n+1/2}, grip residuals, damping sums, q_{n+1} = q_n + dt v_{n+1/2}",
+       std::max(0.0, advance - interfaces), bytes.nodes},
+      {"  (positions)", "alone, for comparison: q += dt v over all DOF as a pass of its own (the step does it in the node pass)",
+       positions, bytes.positions},
       {"check and rest", "step - advance: the rod stress check as the step runs it (scheduled: " + percent(p.stressComputedFraction) +
        " of the rod elements computed per step), crack measure when something failed, bookkeeping",
        std::max(0.0, step - advance), bytes.stressSchedule + p.stressComputedFraction * bytes.stressCheck},

@@ -24,6 +24,7 @@ struct KernelProfile {
   double dof = 0;
   double triadBytesPerSecond = 0;  // a[i] = b[i] + s c[i] over three vectors far larger than the caches
   double stressComputedFraction = 0;  // rod elements the scheduled deletion check computed, per step, of all
+  double interfaceEvaluatedFraction = 0;  // interfaces the step's law saw (InterfaceSchedule), per step, of all
   std::vector<KernelTiming> kernels;
 };
 

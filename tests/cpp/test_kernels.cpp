@@ -140,6 +140,70 @@ TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
   EXPECT_EQ(scheduled, full);
 }
 
+// The elastic force of an interface (cohesive::elasticForceOnB, what the scheduled pass uses while the secant
+// stiffness is k) is the law's force there, tension and compression alike, to round-off; and the compact form's
+// pieces give computeInterfaceForceOnB bit for bit.
+TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const cohesive::Law& law = sim.materials.law;
+  const VecX q = pseudoRandomField(sim.model.numDofs(), 0.3 * law.delta0());
+  for (int i = 0; i < sim.model.numInterfaces(); ++i) {
+    const int A = sim.model.ifaceNodes[i][0], B = sim.model.ifaceNodes[i][1];
+    const cohesive::SliceInterface& g = sim.ops.ifacePacked[i];
+    const Vec3 uA = q.segment<3>(6 * A), thA = q.segment<3>(6 * A + 3), uB = q.segment<3>(6 * B), thB = q.segment<3>(6 * B + 3);
+    double lm = 0.5 * law.delta0(), lmPieces = lm;
+    const Vec3 F = cohesive::computeInterfaceForceOnB(law, g, uA, thA, uB, thB, lm);
+    ASSERT_EQ(cohesive::secantStiffness(law, lm), law.k);
+    const Vec3 E = cohesive::elasticForceOnB(law, g, uA, thA, uB, thB);
+    ASSERT_LE((F - E).norm(), 1e-13 * law.k * g.area * law.delta0()) << "interface " << i;
+    const Vec3 t = cohesive::computeTraction(law, cohesive::localOpening(g, cohesive::computeOpening(g, uA, thA, uB, thB)), lmPieces);
+    ASSERT_EQ(cohesive::forceOnBOfTraction(g, t), F);
+    ASSERT_EQ(lmPieces, lm);
+  }
+}
+
+// The scheduled interface pass (InterfaceSchedule) along a path that fails some interfaces and comes back: the
+// same histories and failed counts as evaluating every interface by the law, forces within round-off of it;
+// a schedule started afresh part-way (a restart) gives the same forces bit for bit; no thread count matters.
+TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const Model& m = sim.model;
+  const cohesive::Law& law = sim.materials.law;
+  const int n = m.numDofs();
+  const VecX shape = pseudoRandomField(n, 1.0), wobble = pseudoRandomField(n, 1.0).reverse();
+  std::vector<double> lmLaw(m.numInterfaces(), 0.0), lmSched = lmLaw, lmFresh = lmLaw;
+  InterfaceSchedule sched, fresh;
+  VecX before = VecX::Zero(n), fLaw, fSched, fFresh;
+  long evaluated = 0;
+  const int steps = 400, restartAt = 250, threads = omp_get_max_threads();
+  for (int t = 0; t <= steps; ++t) {
+    const double a = 15.0 * law.delta0() * std::sin(M_PI * t / steps);  // out to 15 delta0 and back
+    const VecX q = a * shape + 0.05 * law.delta0() * std::cos(0.3 * t) * wobble;
+    const double moved = t == 0 ? INFINITY : (q - before).cwiseAbs().maxCoeff() * (1 + 1e-12) + 1e-300;
+    before = q;
+    omp_set_num_threads(1 + t % 2);
+    if (t == restartAt) lmFresh = lmSched;
+    const int failedLaw = computeForcesForInterfaces(m, law, sim.ops, q, lmLaw, true, fLaw);
+    advanceInterfaceSchedule(m, law, sim.ops, moved, q.cwiseAbs().maxCoeff(), sched);
+    const int failedSched = computeForcesForInterfacesScheduled(m, law, sim.ops, q, lmSched, sched, fSched);
+    evaluated += sched.evaluated;
+    ASSERT_EQ(failedSched, failedLaw) << "step " << t;
+    for (int i = 0; i < m.numInterfaces(); ++i) ASSERT_EQ(lmSched[i], lmLaw[i]) << "step " << t << ", interface " << i;
+    ASSERT_LE((fSched - fLaw).cwiseAbs().maxCoeff(), 1e-12 * (1e-300 + fLaw.cwiseAbs().maxCoeff())) << "step " << t;
+    if (t >= restartAt) {  // lmFresh holds the histories before this step's update, as a checkpoint would
+      advanceInterfaceSchedule(m, law, sim.ops, t == restartAt ? INFINITY : moved, q.cwiseAbs().maxCoeff(), fresh);
+      computeForcesForInterfacesScheduled(m, law, sim.ops, q, lmFresh, fresh, fFresh);
+      ASSERT_EQ(fFresh, fSched) << "step " << t;
+      ASSERT_EQ(lmFresh, lmSched) << "step " << t;
+    }
+  }
+  omp_set_num_threads(threads);
+  int failed = 0;
+  for (double lm : lmLaw) failed += cohesive::isFailed(law, lm);
+  EXPECT_GT(failed, 0) << "the path should fail some interfaces";
+  EXPECT_LT(evaluated, static_cast<long>(steps + 1) * m.numInterfaces()) << "the schedule should skip some";
+}
+
 // K in node blocks (node_blocks.hpp) against Eigen's sparse product: the rods lie in xy-planes, so the model's
 // K splits into in-plane and out-of-plane DOFs, and the 18-entry product gives the general 36-entry one bit for
 // bit (the sign of a zero aside, which == ignores), both within round-off of K x; a K that couples the groups
