@@ -59,6 +59,20 @@ def test_bad_case_file_one_clear_line(run, tmp_path, text, status, words):
     assert not out.exists(), "nothing may be written before the case is valid"
 
 
+@pytest.mark.parametrize("text, status, words", [
+    (GOOD + "shear_strength_ratio = 0\n", OUT_OF_RANGE, ["'shear_strength_ratio'", "= 0", "(0, 10]"]),
+    (GOOD + "shear_strength_ratio = 12\n", OUT_OF_RANGE, ["'shear_strength_ratio'", "= 12", "(0, 10]"]),
+    (GOOD + 'shear_strength_ratio = "2"\n', WRONG_TYPE, ["'shear_strength_ratio'", '"2"', "wrong type", "(0, 10]"]),
+    (GOOD + 'grip_constraint = "ux"\n', OUT_OF_RANGE, ["'grip_constraint'", '"ux"', '"uy", "uxuy"']),
+    (GOOD + 'grip_profile = "centre"\n', OUT_OF_RANGE,
+     ["'grip_profile'", '"centre"', '"to_right_edge", "about_centre"']),
+])
+def test_bad_model_reading_key_one_clear_line(run, tmp_path, text, status, words):
+    """The keys of the paper's open readings (docs/model.md, Choices the paper leaves open): one line naming the
+    key, the value and what is allowed, before anything is written."""
+    test_bad_case_file_one_clear_line(run, tmp_path, text, status, words)
+
+
 def test_missing_case_file(run, tmp_path):
     r = run("info", tmp_path / "nope.toml")
     assert r.returncode == MISSING_FILE
