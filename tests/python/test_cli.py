@@ -1,5 +1,5 @@
 """Command line: --help on every command, and bad input answered by one clear line and a distinct exit
-status before anything is allocated or written (issues "Foundation" and "Hard cases and faults")."""
+status before anything is allocated or written (docs/verification.md)."""
 import os
 import re
 import subprocess
