@@ -519,6 +519,14 @@ bool isResultNeutral(const std::string& key) {
     return false;
 }
 
+bool isDefaultKeyLine(const std::string& line) {
+    static const CaseParams defaults;
+    const std::string name = line.substr(0, line.find(" = "));
+    for (const KeySpec& s : caseKeys())
+        if (name == s.name) return !s.required && line == name + " = " + formatValue(defaults, s, formatTomlReal);
+    return false;
+}
+
 std::string formatKeysMarkdown() {
     auto cell = [](std::string s) {
         std::string out;

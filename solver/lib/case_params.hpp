@@ -60,6 +60,17 @@ enum class Need { required, optional };
       "interface softening length: (delta_f - delta1)/delta0, the length of the trapezoid's linear drop at "      \
       "fixed Gamma_i (plateau end delta1 = Gamma_i/sigma0 + (delta0 - L)/2); 1 = the symmetric trapezoid, "        \
       "2 Gamma_k_over_sigma0sq - 1 = the triangle (no plateau), the largest allowed")                             \
+    X(shear_strength_ratio, Real, physics, optional, 1, "(]", 0, 10, "", "sigma0",                                \
+      "interface shear strength: beta = shear strength / sigma0 of the mixed-mode law, effective separation "      \
+      "lambda = sqrt(<dn>_+^2 + (dt1^2 + dt2^2)/beta^2), traction S(lambda_max) (<dn>_+, dt1, dt2): stiffness k "  \
+      "in every mode, shear fracture energy beta^2 Gamma_i; 1 = one law in every mode (docs/model.md)")           \
+    X(grip_constraint, Choice, physics, optional, "uy", "[]", 0, 0, "uy|uxuy", "-",                                \
+      "grip constraint: of the top and bottom rows' nodes, uy = u_y prescribed (u_x and the rotations free), "    \
+      "uxuy = u_y prescribed and u_x = 0 (docs/model.md, Loading)")                                                \
+    X(grip_profile, Choice, physics, optional, "to_right_edge", "[]", 0, 0, "to_right_edge|about_centre", "-",     \
+      "grip profile: u_y = +/-(1 - x/w_s) U on the top/bottom row (to_right_edge: v_app at the cracked edge, 0 "    \
+      "at the right edge) or +/-(1 - 2 x/w_s) U (about_centre: the face turned about its centre, v_app at the "    \
+      "cracked edge, -v_app at the right edge) (docs/model.md, Loading)")                                          \
     X(delta0_over_d, Real, physics, optional, 0.1, "(]", 0, 1, "", "d",                                             \
       "interface elastic separation: delta0 = sigma0 / k. In linear kinematics it only scales forces and "          \
       "displacements, so results depend on it only through the loading rate: what is quasi-static is "              \
@@ -208,6 +219,12 @@ const std::vector<KeySpec>& caseKeys();
 // history_every is not among them: the adaptive loading rate and the stability checks act at history rows.
 inline constexpr const char* kResultNeutralKeys[] = {"threads", "checkpoint_interval_s"};
 bool isResultNeutral(const std::string& key);
+
+// Whether a line "key = value" of an effective case (tomlText) gives an optional key its default value, as
+// tomlText writes it: a key at its default is the same case as one without the key, so a key added with the
+// default that is the result before it leaves the identity of every case that does not set it as it was
+// (checkpoint.cpp resultKeys).
+bool isDefaultKeyLine(const std::string& line);
 
 // Markdown table of every key: key, group, default, allowed range, unit/normalisation, meaning.
 std::string formatKeysMarkdown();

@@ -15,13 +15,14 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 9;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 10;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
                                        // the record's static elastic start; 5: history rows hold the kinetic
                                        // energy beyond the loading's motion; 6: ... and the inelastic zone's
                                        // reach, the record its edge warning; 7: the static start
                                        // records whether the model held a mechanism; 8: the record its
-                                       // far-field rod break warning; 9: a CRC-32 of every byte before it
+                                       // far-field rod break warning; 9: a CRC-32 of every byte before it;
+                                       // 10: State's interface dissipation account (empty at beta = 1)
                                        // ends the file (before the trailing magic)
 // The file: magic, version, build, case, fields (transferFields), CRC-32 of all that (4 bytes), magic.
 constexpr std::size_t kTrailerBytes = sizeof(std::uint32_t) + sizeof kMagic;
@@ -115,18 +116,20 @@ void transferFields(Io& io, S& s, R& rec) {
   io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic); io.pod(rec.warnedEdge); io.pod(rec.warnedFarFieldRod);
   io.items(rec.warnings, [&](auto& w) { io.str(w); });
   io.pod(rec.staticStart);
+  io.vec(s.lambdaMaxBooked); io.vec(s.ifaceDissipation);
 }
 
 // The effective case's keys that can change a result, without its comment lines (the source file as given, the
 // preset, the --set options): the same case given by another path, with a --set that repeats the value it has
 // anyway, or with another value of a result-neutral key (case_params.hpp isResultNeutral: threads, checkpoint
-// interval) is the same run.
+// interval) is the same run. A key at its default counts as not given (case_params.hpp isDefaultKeyLine): the
+// keys added since a checkpoint was written, at their defaults, leave its identity as it was.
 std::string resultKeys(const std::string& toml) {
   std::istringstream in(toml);
   std::string line, keys;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;
-    if (isResultNeutral(line.substr(0, line.find(" = ")))) continue;
+    if (isResultNeutral(line.substr(0, line.find(" = "))) || isDefaultKeyLine(line)) continue;
     keys += line + "\n";
   }
   return keys;
@@ -238,7 +241,9 @@ void readCheckpoint(const std::string& path, Simulation& sim, RunRecord& rec) {
   State& s = sim.state;
   transferFields(r, s, rec);
   if (s.lambdaMax.size() != static_cast<std::size_t>(sim.model.numInterfaces()) ||
-      s.beamBroken.size() != static_cast<std::size_t>(sim.model.numBeams()))
+      s.beamBroken.size() != static_cast<std::size_t>(sim.model.numBeams()) ||
+      s.lambdaMaxBooked.size() != s.ifaceDissipation.size() ||
+      (!s.lambdaMaxBooked.empty() && s.lambdaMaxBooked.size() != s.lambdaMax.size()))
     throw CheckpointError("checkpoint '" + path + "' does not fit this model");
   std::uint32_t crc = 0;
   r.pod(crc);  // checked by readHeader: what follows the fields is the trailer

@@ -120,9 +120,13 @@ namespace {
 }
 
 namespace {
-// c of InterfaceSchedule: a bound on |lambda change| / |q change|_inf
-double separationRate(const cohesive::SliceInterface& g) {
-  return std::sqrt(3.0) * (2.0 + std::abs(g.armAy) + std::abs(g.armAz) + std::abs(g.armBy) + std::abs(g.armBz));
+// c of InterfaceSchedule: a bound on |lambda change| / |q change|_inf. The opening's 2-norm moves by at most
+// sqrt(3) (2 + |arms|) |q change|_inf, and lambda of the mixed-mode law (weight 1/beta^2 on the shear part of
+// lambda^2) by at most max(1, 1/beta) times that; the factor is 1 exactly at beta = 1.
+double separationRate(const cohesive::Law& law, const cohesive::SliceInterface& g) {
+  const double shearFactor = std::max(1.0, std::sqrt(law.shearWeight));
+  return shearFactor * std::sqrt(3.0) *
+         (2.0 + std::abs(g.armAy) + std::abs(g.armAz) + std::abs(g.armBy) + std::abs(g.armBz));
 }
 
 double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElasticTrack) * law.delta0(); }
@@ -141,8 +145,8 @@ double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElast
     due = drift;  // off the elastic branch: the law at every step
     return cohesive::forceOnBOfTraction(g, t);
   }
-  const double room = (1.0 - kInterfaceScheduleMargin) * lambdaTrack(law) - cohesive::effectiveSeparation(opening);
-  due = room > 0 ? drift + room / separationRate(g) : drift;  // (a NaN opening: due again)
+  const double room = (1.0 - kInterfaceScheduleMargin) * lambdaTrack(law) - cohesive::effectiveSeparation(law, opening);
+  due = room > 0 ? drift + room / separationRate(law, g) : drift;  // (a NaN opening: due again)
   return cohesive::elasticForceOnB(law, g, uA, thA, uB, thB);
 }
 }  // namespace
@@ -153,7 +157,7 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
     schedule.drift = 0;
     schedule.due.assign(m.numInterfaces(), 0.0);
     schedule.largestRate = 0;
-    for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(g));
+    for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(law, g));
   } else {
     schedule.drift += moved * (1.0 + 1e-6);  // the 1e-6 covers the round-off of this running sum
   }

@@ -43,8 +43,9 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 /// The lumped step's schedule of the interface law. An interface on the elastic branch (secantStiffness = k)
 /// exerts cohesive::elasticForceOnB, linear in its DOFs; the law (cohesive::computeTraction) is needed only to
 /// notice it leave its elastic track (cohesive.hpp), and it cannot while its effective separation lambda stays
-/// below (1 - kInterfaceScheduleMargin) lambdaTrack (lambdaTrack = sqrt(kElasticTrack) delta0). lambda moves by
-/// at most c |q change|_inf, c = sqrt(3) (2 + |rA,y| + |rA,z| + |rB,y| + |rB,z|) (lambda is 1-Lipschitz in the
+/// below (1 - kInterfaceScheduleMargin) lambdaTrack (lambdaTrack = sqrt(kElasticTrack) delta0; lambda of the
+/// mixed-mode law, cohesive::effectiveSeparation(law, .)). lambda moves by at most c |q change|_inf,
+/// c = max(1, 1/beta) sqrt(3) (2 + |rA,y| + |rA,z| + |rB,y| + |rB,z|) (lambda is max(1, 1/beta)-Lipschitz in the
 /// opening, whose components each move by at most their row's sum of |coefficients| times |q change|_inf): so
 /// an interface whose lambda was computed when the displacements' drift (as in StressCheckSchedule) stood at D
 /// need not see the law before the drift reaches D + ((1 - margin) lambdaTrack - lambda) / c. Every other

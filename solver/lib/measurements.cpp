@@ -24,9 +24,29 @@ double strainEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const 
 
 double fractureEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const State& s) {
   double sum = 0;
+  if (!law.isotropic()) {
+    for (int i = 0; i < m.numInterfaces(); ++i) sum += m.ifaceGeom[i].area * s.ifaceDissipation[i];
+    return sum;
+  }
   for (int i = 0; i < m.numInterfaces(); ++i)
     sum += m.ifaceGeom[i].area * cohesive::dissipatedEnergyDensity(law, s.lambdaMax[i]);
   return sum;
+}
+
+void bookInterfaceDissipation(const Model& m, const cohesive::Law& law, State& s) {
+  if (law.isotropic()) return;
+  const int n = m.numInterfaces();
+  if (s.lambdaMaxBooked.size() != static_cast<std::size_t>(n)) {
+    s.lambdaMaxBooked.assign(n, 0.0);
+    s.ifaceDissipation.assign(n, 0.0);
+  }
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    if (!(s.lambdaMax[i] > s.lambdaMaxBooked[i])) continue;
+    s.ifaceDissipation[i] +=
+        cohesive::dissipationIncrement(law, computeLocalOpening(m, s.q, i), s.lambdaMaxBooked[i], s.lambdaMax[i]);
+    s.lambdaMaxBooked[i] = s.lambdaMax[i];
+  }
 }
 
 int countFailedInterfaces(const cohesive::Law& law, const State& s) {

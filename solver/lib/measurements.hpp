@@ -1,7 +1,7 @@
 #pragma once
 // The measurements of a run, as free functions over its plain data (state.hpp): J at the outer boundary, the
 // crack advance, the energies, the counts of failed and inelastic interfaces, how far the inelastic zone
-// reaches. None changes anything; Simulation::measure gathers them into one /history row. docs/model.md
+// reaches. None changes anything (but bookInterfaceDissipation, the interfaces' dissipation account); Simulation::measure gathers them into one /history row. docs/model.md
 // (Loading, damping, measurements) states each.
 #include "state.hpp"
 
@@ -11,8 +11,15 @@ namespace enamel {
 double strainEnergyOfBeams(const Operators& ops, const State& s);
 /// Strain energy the interfaces hold (summed in a fixed order: independent of the thread count).
 double strainEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const State& s);
-/// Energy the interfaces dissipated (their damage: Gamma_i per area once failed).
+/// Energy the interfaces dissipated (their damage: Gamma_i per area once failed in normal opening; with
+/// shear_strength_ratio = beta != 1 the booked State::ifaceDissipation, beta^2 Gamma_i per area once failed in
+/// pure shear).
 double fractureEnergyOfInterfaces(const Model& m, const cohesive::Law& law, const State& s);
+/// With a law that is not the same in every mode (shear_strength_ratio != 1) only, and the one function here
+/// that changes its State: books each interface's dissipation since the last call, as
+/// cohesive::dissipationIncrement at its current opening from State::lambdaMaxBooked to its lambdaMax (called
+/// after every step: the mode factor is then that of the step that moved lambdaMax). Nothing at beta = 1.
+void bookInterfaceDissipation(const Model& m, const cohesive::Law& law, State& s);
 int countFailedInterfaces(const cohesive::Law& law, const State& s);     // separation past delta_f
 int countInelasticInterfaces(const cohesive::Law& law, const State& s);  // separation past delta0
 

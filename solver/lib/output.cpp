@@ -249,6 +249,9 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "sigma0", p.sigma0());
   attr(g.id, "k", p.k());
   attr(g.id, "softening_over_delta0", p.softening_over_delta0);
+  attr(g.id, "shear_strength_ratio", p.shear_strength_ratio);
+  attr(g.id, "grip_constraint", p.grip_constraint);
+  attr(g.id, "grip_profile", p.grip_profile);
   attr(g.id, "sigma_ru_mean", p.sigma_ru());
   const StaticStart& st = rec.staticStart;
   attr(g.id, "static_start", st.fraction);

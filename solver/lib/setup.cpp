@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <utility>
 
 #include "errors.hpp"
@@ -34,7 +35,16 @@ beam::Section sectionOf(const CaseParams& p) {
 
 cohesive::Law lawOf(const CaseParams& p) {
   if (!p.interfaces_breakable) return cohesive::Law{p.k(), 1e300, 1e300};
-  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma(), p.softening_over_delta0);
+  return cohesive::makeLaw(p.k(), p.sigma0(), p.Gamma(), p.softening_over_delta0, p.shear_strength_ratio);
+}
+
+Grips gripsOf(const CaseParams& p) {
+  Grips g;
+  if (p.grip_profile == "about_centre") g.profile = Grips::Profile::aboutCentre;
+  else if (p.grip_profile != "to_right_edge") throw std::logic_error("grip_profile '" + p.grip_profile + "'");
+  if (p.grip_constraint == "uxuy") g.holdUx = true;
+  else if (p.grip_constraint != "uy") throw std::logic_error("grip_constraint '" + p.grip_constraint + "'");
+  return g;
 }
 
 namespace {
@@ -61,6 +71,7 @@ void describeMaterials(const CaseParams& p, Materials& mat) {
   mat.rodsBreakable = p.rods_breakable;
   mat.deletionRule = p.deletion_rule;
   mat.rodStress = beam::parseRodStress(p.rod_stress);
+  mat.grips = gripsOf(p);
 }
 
 std::vector<double> drawRodStrengths(const Model& m, const CaseParams& p) {
@@ -133,19 +144,20 @@ void setWaveSpeedDampingAndLoading(const CaseParams& p, const Model& m, Material
   mat.loading.rateAdaptMax = p.rate_adapt_max;
 }
 
-void prescribeGrips(const Model& m, Operators& ops) {
+void prescribeGrips(const Model& m, const Grips& grips, Operators& ops) {
   const int n = m.numDofs();
   ops.dofToFree.assign(n, 0);
-  auto prescribe = [&](const std::vector<int>& nodes, double sign) {
-    for (int node : nodes) {
-      ops.prescribedDofs.push_back(6 * node + 1);
-      ops.prescribedShape.push_back(sign * (1.0 - m.X[node].x() / m.w_s));
-      ops.prescribedSlope.push_back(-sign);
-      ops.dofToFree[6 * node + 1] = -1;
-    }
+  auto prescribe = [&](int dof, double shape, double slope) {
+    ops.prescribedDofs.push_back(dof);
+    ops.prescribedShape.push_back(shape);
+    ops.prescribedSlope.push_back(slope);
+    ops.dofToFree[dof] = -1;
   };
-  prescribe(m.topNodes, +1.0);
-  prescribe(m.bottomNodes, -1.0);
+  for (const auto& [nodes, sign] : {std::make_pair(&m.topNodes, +1.0), std::make_pair(&m.bottomNodes, -1.0)})
+    for (int node : *nodes) prescribe(6 * node + 1, grips.shape(sign, m.X[node].x() / m.w_s), grips.slope(sign));
+  if (grips.holdUx)
+    for (const std::vector<int>* nodes : {&m.topNodes, &m.bottomNodes})
+      for (int node : *nodes) prescribe(6 * node, 0.0, 0.0);
   for (int i = 0; i < n; ++i)
     if (ops.dofToFree[i] == 0) { ops.dofToFree[i] = static_cast<int>(ops.freeDofs.size()); ops.freeDofs.push_back(i); }
 }

@@ -14,10 +14,12 @@ beam::Section sectionOf(const CaseParams& p);
 /// The interface law (unbreakable interfaces, for verification runs, keep the elastic branch however far
 /// they open).
 cohesive::Law lawOf(const CaseParams& p);
+/// The grips' profile and constraint (case keys grip_profile, grip_constraint).
+Grips gripsOf(const CaseParams& p);
 
 /// The crossply of the case, with its reduced far field when far_field_slices > 1.
 Model buildModel(const CaseParams& p);
-/// Section, law, deletion rule and rod stress of the case (the materials' pointwise parts).
+/// Section, law, deletion rule, rod stress and grips of the case (the materials' pointwise parts).
 void describeMaterials(const CaseParams& p, Materials& mat);
 /// One strength per rod element, normal(mean, cv), seeded: drawn rod by rod along each rod from its first
 /// slice (a seed's realisation does not depend on how the model numbers its rod elements); an element of the
@@ -35,9 +37,10 @@ void assembleOperators(const Model& m, const Materials& mat, Operators& ops);
 /// E_transverse (measured by measureTransverseModulus unless the case gives it), c_d, the Rayleigh damping
 /// C = a M + b K (a = zeta w_min, b = zeta / w_min, w_min = pi c_d / h_s) and the loading's velocity and ramp.
 void setWaveSpeedDampingAndLoading(const CaseParams& p, const Model& m, Materials& mat);
-/// The grips: u_y of the top (+) and bottom (-) rows prescribed as shape x U, shape = +/-(1 - x/w_s), with
-/// its per-DOF slope; the free DOFs.
-void prescribeGrips(const Model& m, Operators& ops);
+/// The grips: u_y of the top (+) and bottom (-) rows prescribed as shape x U, shape = Grips::shape (default
+/// +/-(1 - x/w_s)), with its per-DOF slope; with Grips::holdUx their u_x = 0 too (shape and slope 0, after the
+/// u_y); the free DOFs.
+void prescribeGrips(const Model& m, const Grips& grips, Operators& ops);
 /// Node -> interface ends (CSR), for the deterministic gather of interface forces.
 void indexInterfacesByNode(const Model& m, Operators& ops);
 /// The slices' ranges of nodes and interfaces and the interfaces' in-slice form; throws SolverError when the

@@ -22,10 +22,11 @@ Simulation::Simulation(const CaseParams& p) : params(p), model(buildModel(p)) {
   buildElementClasses(model, materials);
   assembleOperators(model, materials, ops);
   setWaveSpeedDampingAndLoading(p, model, materials);
-  prescribeGrips(model, ops);
+  prescribeGrips(model, materials.grips, ops);
   indexInterfacesByNode(model, ops);
   indexSlices(model, ops);
   state = stateAtRest(model, ops);
+  bookInterfaceDissipation(model, materials.law, state);  // sizes the account (shear_strength_ratio != 1 only)
   setThreadCount(p, model.numDofs());
   integrator = makeIntegrator(p, model, materials, ops);
   if (integrator->usesHalfStepVelocity()) state.vHalf = VecX::Zero(model.numDofs());
@@ -47,9 +48,14 @@ void Simulation::solveStaticElastic(double U, bool* mechanism) {
   std::vector<int> dofs = ops.prescribedDofs;
   std::vector<double> values;
   for (double sh : ops.prescribedShape) values.push_back(sh * U);
-  const int anchor = model.bottomNodes[0];  // against rigid translation in x and z
-  dofs.insert(dofs.end(), {6 * anchor, 6 * anchor + 2});
-  values.insert(values.end(), {0.0, 0.0});
+  const int anchor = model.bottomNodes[0];  // against rigid translation in x (unless the grips hold u_x) and z
+  if (materials.grips.holdUx) {
+    dofs.push_back(6 * anchor + 2);
+    values.push_back(0.0);
+  } else {
+    dofs.insert(dofs.end(), {6 * anchor, 6 * anchor + 2});
+    values.insert(values.end(), {0.0, 0.0});
+  }
   state.q = solveStaticPrescribed(Kt, dofs, values, mechanism);
   state.v.setZero();
   state.a.setZero();
@@ -78,6 +84,7 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   VecX f;
   state.failedInterfaces = computeForcesForInterfaces(model, materials.law, ops, state.q, state.lambdaMax, true, f);
   integrator->initialise(model, materials, ops, state);
+  bookInterfaceDissipation(model, materials.law, state);
   // the grips did the work the specimen holds (quasi-statically: no damping work is booked for the skipped stage)
   state.externalWork = strainEnergyOfBeams() + strainEnergyOfInterfaces() + integrator->kineticEnergy(ops, state);
   return st;
@@ -87,6 +94,7 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
 void Simulation::step() {
   const int failedBefore = state.failedInterfaces;
   integrator->advance(model, materials, ops, state);
+  bookInterfaceDissipation(model, materials.law, state);
   const int deleted = deleteOverloadedBeams();
   if (deleted > 0 || state.failedInterfaces != failedBefore) state.crackAdvance = measureCrackAdvance();
 }

@@ -23,7 +23,8 @@ using VecX = Eigen::VectorXd;
 using SpMat = Eigen::SparseMatrix<double>;
 
 /// Graded velocity loading on the top and bottom boundary rows (docs/solver.md):
-///   u_y = +/- U(t) (1 - x / w_s),  U' = v_app r(t),  r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
+///   u_y = +/- U(t) (1 - x / w_s) (Grips, below: the default profile),  U' = v_app r(t),
+///   r(t) = (1 - cos(pi t / T_r)) / 2 for t < T_r, then 1.
 /// With an adaptive rate (rateAdaptMax > 1, loading_rate.hpp) the argument is the loading clock tau, not t.
 struct Loading {
   double vApp = 0;      // peak applied velocity at the cracked edge
@@ -36,6 +37,22 @@ struct Loading {
   /// The time t >= 0 at which displacement(t) = U (U >= 0): closed form after the ramp, bisection within it
   /// (displacement is strictly increasing for t > 0).
   double timeOfDisplacement(double U) const;
+};
+
+/// The grips on the top (sign +1) and bottom (sign -1) rows (case keys grip_profile, grip_constraint; docs/model.md,
+/// Loading): u_y = shape(sign, x/w_s) U(t) with
+///   toRightEdge (default):  shape = sign (1 - x/w_s)      v_app at the cracked edge x = 0, 0 at x = w_s
+///   aboutCentre:            shape = sign (1 - 2 x/w_s)    the face turned about its centre: +/-v_app at x = 0,
+///                                                          -/+v_app at x = w_s
+/// and slope = d shape / d(x/w_s); holdUx: u_x = 0 on the same nodes too (otherwise u_x and the rotations are free).
+struct Grips {
+  enum class Profile { toRightEdge, aboutCentre };
+  Profile profile = Profile::toRightEdge;
+  bool holdUx = false;
+  double shape(double sign, double xOverWs) const {
+    return profile == Profile::toRightEdge ? sign * (1.0 - xOverWs) : sign * (1.0 - 2.0 * xOverWs);
+  }
+  double slope(double sign) const { return profile == Profile::toRightEdge ? -sign : -2.0 * sign; }
 };
 
 /// Set up once from the case; a run never changes it.
@@ -59,15 +76,17 @@ struct Materials {
   double E_transverse = 0, c_d = 0;  // transverse modulus and wave speed
   double omegaMin = 0, dampA = 0, dampB = 0;  // Rayleigh: C = dampA M + dampB K
   Loading loading;
+  Grips grips;
 };
 
 /// The assembled operators. K and M hold the rods only (interfaces are never assembled) and lose a rod
 /// element's stiffness (and consistent-minus-lumped mass) when it is deleted.
 struct Operators {
   SpMat K, M;
-  // Prescribed DOFs (u_y of the boundary rows) and their shape: u = shape * U(t), shape = +/-(1 - x/w_s),
-  // and its slope d shape / d(x/w_s): -1 on the top row, +1 on the bottom row (per DOF, because the shape's
-  // sign cannot tell the rows apart at x = w_s, where it is +/-0).
+  // Prescribed DOFs (u_y of the boundary rows, then their u_x when Grips::holdUx) and their shape: u = shape *
+  // U(t), shape = Grips::shape (default +/-(1 - x/w_s); 0 for u_x), and its slope d shape / d(x/w_s) (default
+  // -1 on the top row, +1 on the bottom row; 0 for u_x), per DOF, because the shape's sign cannot tell the rows
+  // apart where it is +/-0 (x = w_s; x = w_s/2 about the centre).
   std::vector<int> prescribedDofs;
   std::vector<double> prescribedShape;
   std::vector<double> prescribedSlope;
@@ -101,6 +120,10 @@ struct State {
   VecX vHalf;                          // half-step velocity v_{n-1/2} (`lumped`; empty for `paper`)
   VecX reaction;                       // force the grips apply at each prescribed DOF (last step)
   std::vector<double> lambdaMax;       // per interface: largest effective separation reached
+  // per interface, only when the law is not the same in every mode (shear_strength_ratio != 1; empty otherwise):
+  // the lambdaMax up to which its dissipation is booked, and that dissipation per area (measurements.hpp
+  // bookInterfaceDissipation: it then depends on the mode the interface failed in, not on lambdaMax alone)
+  std::vector<double> lambdaMaxBooked, ifaceDissipation;
   std::vector<std::uint8_t> beamBroken;  // per rod element: deleted
   std::vector<int> deletionOrder;        // rod elements in the order they were deleted (K, M are rebuilt so)
   // energy accumulators (time integrals)

@@ -86,7 +86,7 @@ double computeFirstDamageDisplacement(const Model& m, const Materials& mat, cons
     // the largest effective separation lambda_i(q1) (no interface is assembled or changed)
     double worst = 0;
     for (int i = 0; i < m.numInterfaces(); ++i)
-      worst = std::max(worst, cohesive::effectiveSeparation(computeLocalOpening(m, q1, i)));
+      worst = std::max(worst, cohesive::effectiveSeparation(mat.law, computeLocalOpening(m, q1, i)));
     if (worst > 0) uc = mat.law.delta0() / worst;
   }
   if (mat.rodsBreakable && m.numBeams() > 0) {

@@ -2,6 +2,7 @@
 committed before the runs).
 
     python3 -m studies.square.square run S G [--he H] [--rate F]   # one run (one thread) and its record
+    python3 -m studies.square.square run S G --case CASE           # a validation run of another paper case
     python3 -m studies.square.square record RUN_DIR                # the record of a finished run
     python3 -m studies.square.square report                        # README's Results and rcurves.png from the records
 
@@ -21,7 +22,8 @@ import sys
 import h5py
 import numpy as np
 
-from enamel_results import metrics, paths, records, results
+from enamel_results import cases, metrics, paper_values, paths, records, results
+from figures import summary_table
 
 HERE = pathlib.Path(__file__).resolve().parent
 DATA = HERE / "data"
@@ -32,17 +34,18 @@ SELECT_WINDOW = (5.0, 25.0)  # the rule's mean
 NUMERICS = {"integrator": '"lumped"', "dt_factor": "0.22", "damping_cap": "0.5", "static_start": "0.95"}
 
 
-def run_name(size: float, G: float, he: float = 0.3, rate: float = 1.0, extra: str = "") -> str:
-    name = f"s{size:g}_he{he:g}_G{G:g}" + (f"_rate{rate:g}" if rate != 1.0 else "")
+def run_name(size: float, G: float, he: float = 0.3, rate: float = 1.0, extra: str = "", case: str = CASE) -> str:
+    """s80_he0.3_G10[_rate0.5][_extra] for the study's case; <case>_s80_he0.3_G10... for a validation case."""
+    name = (f"{case}_" if case != CASE else "") + f"s{size:g}_he{he:g}_G{G:g}" + (f"_rate{rate:g}" if rate != 1.0 else "")
     return name + (f"_{extra}" if extra else "")
 
 
-def solver_args(binary, size, G, he, rate, out, sets=()) -> list[str]:
+def solver_args(binary, size, G, he, rate, out, sets=(), case: str = CASE) -> list[str]:
     over = {"w_s_over_d": f"{size:g}", "h_s_over_d": f"{size:g}", "Gamma_k_over_sigma0sq": f"{G:g}",
             "h_e_over_d": f"{he:g}", "rate_factor": f"{rate:g}", **NUMERICS, "threads": "1",
             "checkpoint_interval_s": "600"}
     over.update(dict(s.split("=", 1) for s in sets))
-    args = [str(binary), "run", str(paths.case_file(CASE)), "--preset", "paper", "--resume", "-o", str(out)]
+    args = [str(binary), "run", str(paths.case_file(case)), "--preset", "paper", "--resume", "-o", str(out)]
     for k, v in over.items():
         args += ["--set", f"{k}={v}"]
     return args
@@ -164,9 +167,9 @@ def pairs(recs: dict) -> list[tuple[str, str, str, float, float]]:
     return out
 
 
-def selection(recs: dict, checks: list) -> list[str]:
+def selection(recs: dict, checks: list) -> tuple[list[str], float | None]:
     """The rule: converged (size, mesh and a rate twin, each the same) and nearest PAPER_LEVEL by the (5,25] mean of
-    the size pair, rods breaking."""
+    the size pair, rods breaking. The table and the selected G (None: none yet)."""
     lines = ["| G | size | mesh | rate twin | (5,25] mean of the size pair | rods break | converged |", "|---|---|---|---|---|---|---|"]
     best = None
     for G in sorted({c[4] for c in checks} | {r["params"]["Gamma_k_over_sigma0sq"] for r in recs.values()}):
@@ -186,7 +189,71 @@ def selection(recs: dict, checks: list) -> list[str]:
     lines += ["", f"**Selected by the records so far: G = {best[0]:g}** ((5,25] mean {best[1]:.2f} against the paper's "
               f"~{PAPER_LEVEL:g}; values recorded: {tried})."
               if best else "**Selected: none yet** (no G is converged in size, mesh and rate by the records so far)."]
-    return lines
+    return lines, (best[0] if best else None)
+
+
+# ------------------------------------------------------------------------------------------- the validation
+# The paper's statements (figures/paper_values.toml) at the selected G, each at the largest size run for its case
+# (README, "Changes to the plan": '~' within 20%, '=' within 3%, '>=' as stated; trends by the summary table's rule).
+VALIDATION_TOL = {"~": 0.20, "=": 0.03}
+OURS = {"R_ss_over_Gamma": "(5,25] mean", "R_init_over_Gamma": "R_init", "da_first_rod_fracture_over_d": "first rod break"}
+
+
+class Level:
+    """A record as figures.summary_table.check_trends reads a result: params, R_init, and R_ss = the (5,25] mean."""
+    def __init__(self, rec: dict):
+        self.params, self.R_init, self.R_ss = cases.params_from_name(rec["case"]), rec["R_init"], level(rec, *SELECT_WINDOW)
+
+    def param(self, key: str) -> float:
+        return float(self.params[key])
+
+
+def ours(rec: dict, quantity: str) -> float:
+    if quantity == "R_ss_over_Gamma":
+        return level(rec, *SELECT_WINDOW)
+    if quantity == "R_init_over_Gamma":
+        return rec["R_init"]
+    return first_break(rec) if rec.get("rod_da") else math.inf   # no rod broke: none before any advance
+
+
+def value_verdict(v: dict, x: float) -> str:
+    if v["relation"] == ">=":
+        return "reproduced" if x >= v["value"] else "**not reproduced**"
+    rel, tol = (x - v["value"]) / v["value"], VALIDATION_TOL[v["relation"]]
+    return f"{'reproduced' if abs(rel) <= tol else '**not reproduced**'} ({pct(rel)}; tolerance {tol:.0%})"
+
+
+def largest_per_case(recs: dict, G: float) -> dict[str, dict]:
+    """{case: the record at G, h_e 0.3, the preset's rate and the largest size} of every case run at G."""
+    out = {}
+    for name, rec in recs.items():
+        p = rec["params"]
+        if (p["Gamma_k_over_sigma0sq"] == G and p["h_e_over_d"] == 0.3 and p["rate_factor"] == 1.0
+                and name == run_name(p["w_s_over_d"], G, case=rec["case"])
+                and p["w_s_over_d"] >= out.get(rec["case"], {}).get("params", {}).get("w_s_over_d", 0)):
+            out[rec["case"]] = rec
+    return out
+
+
+def validation(recs: dict, G: float) -> list[str]:
+    """The statements table and the trends at G, from the records."""
+    pv, at = paper_values.paper_values(), largest_per_case(recs, G)
+    lines = [f"At G = {G:g}, each case at the largest size run for it (the (5,25] mean stands for R_ss, as in the "
+             "selection; theta30 (21.4, 10)'s R_ss ~ 7 is the selection's target, not a validation).", "",
+             "| statement | paper | ours | run | verdict |", "|---|---|---|---|---|"]
+    for v in pv["value"]:
+        if v.get("case") in at and v["quantity"] in OURS:
+            rec = at[v["case"]]
+            fitted = " (the selection's own quantity: not a validation)" if (
+                v["case"] == CASE and v["quantity"] == "R_ss_over_Gamma") else ""
+            lines.append(f"| {v['id']}: {OURS[v['quantity']]} | {paper_values.paper_value_text(v)} | "
+                         f"{fmt(ours(rec, v['quantity']))} | {rec['name']} | {value_verdict(v, ours(rec, v['quantity']))}{fitted} |")
+    trends = {"trend": [t for t in pv["trend"] if t["quantity"] in ("R_init_over_Gamma", "R_ss_over_Gamma")]}
+    rows = [f"| {t['id']} ({t['quantity']} against {t['against']}) | {label} | "
+            f"{', '.join(f'{x:g}: {y:.3g}' for x, y in pts)} | {verdict} |"
+            for t, series in summary_table.check_trends({n: Level(r) for n, r in at.items()}, trends)
+            for label, pts, verdict in series if len(pts) >= 2]
+    return lines + (["", "| trend | series | points (x: y) | verdict |", "|---|---|---|---|"] + rows if rows else [])
 
 
 def figure(recs: dict, out: pathlib.Path) -> None:
@@ -212,15 +279,19 @@ def figure(recs: dict, out: pathlib.Path) -> None:
 def report(data: pathlib.Path = DATA, readme: pathlib.Path = HERE / "README.md") -> str:
     """Rewrite everything below README's "## Results" from the records; the figure goes next to the README."""
     recs = load_records(data)
-    checks = pairs(recs)
+    study = {n: r for n, r in recs.items() if r.get("case", CASE) == CASE}   # the rest: validation cases
+    checks = pairs(study)
+    chosen, G = selection(study, checks)
     lines = ["", "Generated by `python3 -m studies.square.square report` from `data/*.json`. R is R/Gamma_i averaged over",
              "crack advance in each window (d); the (5,25] mean decides the selection. The earlier studies' records",
              "judged by the same measure: [rejudged.md](rejudged.md).", "", "### Runs", ""]
     lines += run_rows(recs) + ["", "### Convergence checks (the measure; L2 and windows reported only)", ""]
     lines += PAIR_HEAD + [compare_line(*c[:3], recs, c[3])[0] for c in checks]
-    lines += ["", "### Selection", ""] + selection(recs, checks) + [""]
-    if recs:
-        figure(recs, readme.parent / "rcurves.png")
+    lines += ["", "### Selection", ""] + chosen + [""]
+    if G is not None:
+        lines += ["### Validation (reported, never fitted)", ""] + validation(recs, G) + [""]
+    if study:
+        figure(study, readme.parent / "rcurves.png")
         lines += ["![R-curves](rcurves.png)", ""]
     text = readme.read_text()
     head = text.split("\n## Results\n", 1)[0]
@@ -239,6 +310,7 @@ def main(argv=None) -> int:
     r.add_argument("--rate", type=float, default=1.0, help="rate_factor (default 1)")
     r.add_argument("--set", action="append", default=[], help="further key=value for the solver (named in the run)")
     r.add_argument("--name", default="", help="suffix of the run's name (required with --set)")
+    r.add_argument("--case", default=CASE, help=f"paper case (default {CASE}; another one is a validation run)")
     r.add_argument("--binary", default=str(paths.SOLVER))
     rec = sub.add_parser("record", help="record a finished run")
     rec.add_argument("run_dir", type=pathlib.Path)
@@ -247,10 +319,12 @@ def main(argv=None) -> int:
     if a.cmd == "run":
         if a.set and not a.name:
             ap.error("--set needs --name (the run's name must say what differs)")
-        name = run_name(a.size, a.G, a.he, a.rate, a.name)
+        if not paths.case_file(a.case).exists():
+            ap.error(f"--case {a.case}: no such paper case ({paths.case_file(a.case)} missing)")
+        name = run_name(a.size, a.G, a.he, a.rate, a.name, a.case)
         out = RUNS / name
         out.mkdir(parents=True, exist_ok=True)
-        rc = subprocess.call(solver_args(a.binary, a.size, a.G, a.he, a.rate, out, a.set))
+        rc = subprocess.call(solver_args(a.binary, a.size, a.G, a.he, a.rate, out, a.set, a.case))
         print(f"square: solver exit {rc}; recorded {store(record_of(out, name))}")
         return rc
     if a.cmd == "record":

@@ -525,3 +525,53 @@ TEST(CaseParams, RodStressChoices) {
     EXPECT_EQ(e.exitCode, exit_code::out_of_range);
     expectMessage(e, {"'rod_stress'", "\"von_mises\"", "\"axial_bending\"", "\"axial\"", "\"principal\""});
 }
+
+// The open readings of the model: shear_strength_ratio (0, 10], grip_constraint uy|uxuy, grip_profile
+// to_right_edge|about_centre; defaults 1, "uy", "to_right_edge"; a bad value is one line naming the key, the
+// value and what is allowed.
+TEST(CaseParams, ModelReadingKeysDefaultsAndBadValues) {
+    const CaseParams d = parse("");
+    EXPECT_EQ(d.shear_strength_ratio, 1.0);
+    EXPECT_EQ(d.grip_constraint, "uy");
+    EXPECT_EQ(d.grip_profile, "to_right_edge");
+    const CaseParams set = parse("shear_strength_ratio = 2.5\ngrip_constraint = \"uxuy\"\ngrip_profile = \"about_centre\"\n");
+    EXPECT_EQ(set.shear_strength_ratio, 2.5);
+    EXPECT_EQ(set.grip_constraint, "uxuy");
+    EXPECT_EQ(set.grip_profile, "about_centre");
+    EXPECT_EQ(parse("", "", {"shear_strength_ratio=10"}).shear_strength_ratio, 10.0);
+    for (const char* bad : {"0", "-1", "10.5", "nan"}) {
+        const auto e = caseErrorOf([&] { parse("", "", {std::string("shear_strength_ratio=") + bad}); });
+        EXPECT_EQ(e.exitCode, exit_code::out_of_range) << bad;
+        expectMessage(e, {"'shear_strength_ratio'", std::string("= ") + bad, "(0, 10]"});
+    }
+    const auto constraint = caseErrorOf([] { parse("grip_constraint = \"ux\"\n"); });
+    EXPECT_EQ(constraint.exitCode, exit_code::out_of_range);
+    expectMessage(constraint, {"'grip_constraint'", "\"ux\"", "\"uy\", \"uxuy\""});
+    const auto profile = caseErrorOf([] { parse("grip_profile = \"centre\"\n"); });
+    EXPECT_EQ(profile.exitCode, exit_code::out_of_range);
+    expectMessage(profile, {"'grip_profile'", "\"centre\"", "\"to_right_edge\", \"about_centre\""});
+    const auto type = caseErrorOf([] { parse("grip_profile = 1\n"); });
+    EXPECT_EQ(type.exitCode, exit_code::wrong_type);
+    expectMessage(type, {"'grip_profile'", "wrong type"});
+}
+
+// A key at its default counts as not given in a checkpoint's identity (isDefaultKeyLine): every optional key's
+// line of the defaults' effective case is a default line, the same key with another value is not, required keys
+// never are, and other lines are not key lines of the table.
+TEST(CaseParams, DefaultKeyLinesAreThoseOfTheDefaults) {
+    const CaseParams d = parse("");
+    std::istringstream lines(d.tomlText);
+    std::string line;
+    std::set<std::string> atDefault;
+    while (std::getline(lines, line))
+        if (enamel::isDefaultKeyLine(line)) atDefault.insert(line.substr(0, line.find(" = ")));
+    for (const KeySpec& s : enamel::caseKeys()) EXPECT_EQ(atDefault.count(s.name), s.required ? 0u : 1u) << s.name;
+    EXPECT_TRUE(enamel::isDefaultKeyLine("shear_strength_ratio = 1.0"));
+    EXPECT_TRUE(enamel::isDefaultKeyLine("grip_profile = \"to_right_edge\""));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("shear_strength_ratio = 2.0"));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("grip_constraint = \"uxuy\""));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("grip_profile = \"about_centre\""));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("theta_D = 0.0"));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("# preset: ci"));
+    EXPECT_FALSE(enamel::isDefaultKeyLine("not_a_key = 1.0"));
+}

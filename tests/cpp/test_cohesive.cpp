@@ -552,3 +552,209 @@ TEST(Cohesive, ElasticTrackEqualsThePlainMaximum) {
   EXPECT_GT(recorded, 1000) << "and left";
   EXPECT_GT(differing, 1000) << "so lambdaMax does differ below delta0";
 }
+
+// --- shear_strength_ratio: the mixed-mode law, lambda = sqrt(<dn>_+^2 + (dt1^2 + dt2^2)/beta^2) ------------------
+
+namespace {
+
+// The peak traction magnitude and the work along a monotonic opening s * e from 0 to 1.2 sFail, e a unit
+// direction, sFail the opening size at which lambda = deltaf; each leg ends at a kink of the envelope (lambda =
+// delta0, delta1, deltaf: s = lambda / lambda(e)), and the traction is linear in s on each, so the trapezoid rule
+// is exact. Also the dissipation booked along it, as the solver books it (dissipationIncrement at each point).
+struct MonotonicPath { double peak, work, booked, lambdaMax; };
+
+MonotonicPath monotonicPath(const Law& law, const Vec3& e, int n = 400) {
+  const double perUnit = effectiveSeparation(law, e);  // lambda of the unit opening e
+  const std::vector<double> breaks = {0.0, law.delta0() / perUnit, law.delta1() / perUnit, law.deltaf() / perUnit,
+                                      1.2 * law.deltaf() / perUnit};
+  MonotonicPath r{0.0, 0.0, 0.0, 0.0};
+  Vec3 tPrev = computeTraction(law, Vec3::Zero(), r.lambdaMax);
+  for (std::size_t b = 1; b < breaks.size(); ++b)
+    for (int i = 1; i <= n; ++i) {
+      const double s0 = breaks[b - 1] + (breaks[b] - breaks[b - 1]) * (i - 1) / n;
+      const double s1 = breaks[b - 1] + (breaks[b] - breaks[b - 1]) * i / n;
+      const double before = r.lambdaMax;
+      const Vec3 t = computeTraction(law, s1 * e, r.lambdaMax);
+      r.work += 0.5 * (tPrev + t).dot((s1 - s0) * e);
+      r.booked += dissipationIncrement(law, s1 * e, before, r.lambdaMax);
+      r.peak = std::max(r.peak, t.norm());
+      tPrev = t;
+    }
+  return r;
+}
+
+}  // namespace
+
+// Pure shear (along t1, t2 and between them): elastic stiffness k, strength beta sigma0, fracture energy
+// beta^2 Gamma, failed at the end; and the booked dissipation is the work done (everything dissipated: the
+// traction is 0 at the end). Pure normal opening keeps sigma0 and Gamma whatever beta.
+TEST(Cohesive, ShearStrengthRatioSetsShearStrengthAndToughness) {
+  for (double beta : {0.3, 0.5, 1.0, 2.0, 3.5}) {
+    const Law law = makeLaw(0.1, 1e-4, 3e-7, 1.0, beta);
+    EXPECT_EQ(law.shearStrengthRatio, beta);
+    for (const Vec3& e : {Vec3(0, 1, 0), Vec3(0, 0, -1), Vec3(0, 0.6, 0.8)}) {
+      double lm = 0.0;
+      const Vec3 tSmall = computeTraction(law, 1e-3 * law.delta0() * e, lm);
+      EXPECT_NEAR((tSmall - law.k * 1e-3 * law.delta0() * e).norm(), 0.0, kRoundoff * law.k * law.delta0()) << beta;
+      const MonotonicPath p = monotonicPath(law, e);
+      EXPECT_NEAR(p.peak, beta * law.sigma0, kRoundoff * beta * law.sigma0) << "beta " << beta;
+      EXPECT_NEAR(p.work, beta * beta * law.Gamma, kWorkTol * beta * beta * law.Gamma) << "beta " << beta;
+      EXPECT_NEAR(p.booked, p.work, kWorkTol * p.work) << "beta " << beta;
+      EXPECT_TRUE(isFailed(law, p.lambdaMax)) << beta;
+      EXPECT_NEAR(modeFactor(law, e), beta * beta, kRoundoff * beta * beta);
+    }
+    const MonotonicPath normal = monotonicPath(law, Vec3(1, 0, 0));
+    EXPECT_NEAR(normal.peak, law.sigma0, kRoundoff * law.sigma0) << beta;
+    EXPECT_NEAR(normal.work, law.Gamma, kWorkTol * law.Gamma) << beta;
+    EXPECT_NEAR(normal.booked, law.Gamma, kWorkTol * law.Gamma) << beta;
+    EXPECT_NEAR(dissipatedEnergyDensity(law, normal.lambdaMax), law.Gamma, kRoundoff * law.Gamma) << beta;
+    // a mixed radial opening: the work is the mode factor times Gamma, and so is the booked dissipation
+    const Vec3 mixed = Vec3(0.6, -0.48, 0.64).normalized();
+    const double lambdaMixed = effectiveSeparation(law, mixed), m = mixed.squaredNorm() / (lambdaMixed * lambdaMixed);
+    EXPECT_NEAR(modeFactor(law, mixed), m, kRoundoff * m) << beta;
+    const MonotonicPath p = monotonicPath(law, mixed);
+    EXPECT_NEAR(p.work, m * law.Gamma, kWorkTol * m * law.Gamma) << beta;
+    EXPECT_NEAR(p.booked, m * law.Gamma, kWorkTol * m * law.Gamma) << beta;
+  }
+}
+
+// The shear toughness, derived: in pure shear lambda = |dt|/beta, so |t| = S(lambda) |dt| = beta T(lambda) and
+// int |t| d|dt| = int beta T(lambda) beta dlambda = beta^2 Gamma. Integrated here with the envelope alone (no
+// computeTraction), as a check of the derivation that the test above checks on the law.
+TEST(Cohesive, ShearToughnessIsBetaSquaredGammaByTheEnvelope) {
+  for (double beta : {0.5, 2.0}) {
+    const Law law = makeLaw(0.1, 1e-4, 3e-7, 2.0, beta);
+    const int n = 200000;
+    const double dtEnd = 1.1 * beta * law.deltaf();
+    double work = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double dt = (i + 0.5) * dtEnd / n;  // midpoint rule
+      work += beta * envelopeTraction(law, dt / beta) * dtEnd / n;
+    }
+    EXPECT_NEAR(work, beta * beta * law.Gamma, 1e-6 * beta * beta * law.Gamma) << beta;
+  }
+}
+
+// beta = 1 is the law before the key, bit for bit, on random openings (both signs of dn, every branch) and
+// histories: the separation, the traction (and the history it leaves), the stored energy, the mode factor and
+// the dissipation increment, against the formulas written out.
+TEST(Cohesive, ShearStrengthRatioOneIsTodaysLawBitForBit) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.0, 1.0);
+  for (const auto& [k, sigma0, Gamma] : std::vector<std::array<double, 3>>{
+           {0.1, 0.01, 3 * 1e-4 / 0.1}, {0.1, 0.01, 8 * 1e-4 / 0.1}, {0.1, 1e-4, 3e-7}, {0.05, 0.005, 7.3e-4}}) {
+    const Law L = makeLaw(k, sigma0, Gamma, 1.0, 1.0);
+    const TodaysLaw T{k, sigma0, Gamma};
+    EXPECT_TRUE(L.isotropic());
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3 o = 1.3 * T.df() * Vec3(u(rng), u(rng), u(rng));
+      const double lambdaOld = std::sqrt(std::max(o(0), 0.0) * std::max(o(0), 0.0) + o(1) * o(1) + o(2) * o(2));
+      ASSERT_TRUE(sameBits(effectiveSeparation(L, o), lambdaOld)) << i;
+      ASSERT_TRUE(sameBits(effectiveSeparation(L, o), effectiveSeparation(o))) << i;
+      const double h0 = pos(rng) * 1.2 * T.df();
+      double hNew = h0;
+      const Vec3 tNew = computeTraction(L, o, hNew);
+      const double hOld = std::max(h0, lambdaOld), S = T.secant(hOld);
+      const Vec3 tOld(S * std::max(o(0), 0.0) + k * std::min(o(0), 0.0), S * o(1), S * o(2));
+      for (int c = 0; c < 3; ++c) ASSERT_TRUE(sameBits(tNew(c), tOld(c))) << i;
+      if (!sameBits(hNew, hOld)) ASSERT_TRUE(hOld < T.d0() && hNew == h0) << i;
+      const double dnNeg = std::max(-o(0), 0.0);
+      const double storedOld = 0.5 * T.secant(std::max(h0, lambdaOld)) * lambdaOld * lambdaOld + 0.5 * k * dnNeg * dnNeg;
+      ASSERT_TRUE(sameBits(storedEnergyDensity(L, o, h0), storedOld)) << i;
+      ASSERT_EQ(modeFactor(L, o), 1.0);
+      const double h1 = h0 + pos(rng) * T.df();
+      ASSERT_TRUE(sameBits(dissipationIncrement(L, o, h0, h1),
+                           dissipatedEnergyDensity(L, h1) - dissipatedEnergyDensity(L, h0)) ||
+                  dissipatedEnergyDensity(L, h1) == dissipatedEnergyDensity(L, h0))
+          << i;
+    }
+  }
+}
+
+// The elastic track with beta != 1: its bound is on the mixed-mode lambda, so along random paths across delta0
+// the traction and everything computed from lambdaMax equal those of the plain maximum of lambda, bit for bit
+// (as ElasticTrackEqualsThePlainMaximum at beta = 1).
+TEST(Cohesive, ElasticTrackHoldsForTheMixedModeLambda) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int tracked = 0, recorded = 0;
+  for (double beta : {0.4, 2.5}) {
+    const Law law = makeLaw(0.1, 1e-4, 3e-7, 1.0, beta);
+    const double d0 = law.delta0();
+    for (int path = 0; path < 200; ++path) {
+      const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+      const double peak = d0 * (path % 3 == 0 ? std::sqrt(kElasticTrack) * (1 + 3e-7 * unit(rng)) : 1.5 + unit(rng)) /
+                          effectiveSeparation(law, dir);
+      double lmTrack = 0, lmPlain = 0;
+      for (int i = 0; i <= 200; ++i) {
+        const double s = std::abs(std::sin(0.05 * i * (1 + path % 7)));
+        const Vec3 o = peak * s * dir + 0.01 * d0 * Vec3(unit(rng), unit(rng), unit(rng));
+        const double before = lmTrack;
+        const Vec3 tTrack = computeTraction(law, o, lmTrack);
+        lmPlain = std::max(lmPlain, effectiveSeparation(law, o));
+        const double S = secantStiffness(law, lmPlain);
+        const Vec3 tPlain(S * std::max(o(0), 0.0) + law.k * std::min(o(0), 0.0), S * o(1), S * o(2));
+        tracked += lmTrack == before && effectiveSeparation(law, o) > before;
+        recorded += lmTrack > before;
+        for (int j = 0; j < 3; ++j) ASSERT_EQ(tTrack[j], tPlain[j]) << "beta " << beta << " path " << path;
+        ASSERT_EQ(damage(law, lmTrack), damage(law, lmPlain));
+        ASSERT_EQ(dissipatedEnergyDensity(law, lmTrack), dissipatedEnergyDensity(law, lmPlain));
+        ASSERT_EQ(storedEnergyDensity(law, o, lmTrack), storedEnergyDensity(law, o, lmPlain));
+        ASSERT_EQ(isInelastic(law, lmTrack), isInelastic(law, lmPlain));
+        ASSERT_EQ(isFailed(law, lmTrack), isFailed(law, lmPlain));
+        if (lmTrack != lmPlain) ASSERT_LT(lmPlain, d0);
+      }
+    }
+  }
+  EXPECT_GT(tracked, 500) << "the track is taken";
+  EXPECT_GT(recorded, 500) << "and left";
+}
+
+// The energy account along a path that changes mode (shear past the peak, unloading, normal opening with some
+// shear, contact, then shear again to failure), in small steps: the work done equals the stored energy plus the
+// dissipation booked step by step (dissipationIncrement at the step's end), within the steps' O(h) error.
+// lambdaMax alone does not give it: the normal-mode dissipatedEnergyDensity misses the shear part.
+TEST(Cohesive, MixedModeWorkIsStoredPlusBookedDissipation) {
+  for (double beta : {0.5, 2.0}) {
+    const Law law = makeLaw(0.1, 1e-4, 3e-7, 1.0, beta);
+    const double d0 = law.delta0(), b = beta;
+    const std::vector<Vec3> corners = {Vec3::Zero(), Vec3(0, 1.6 * b * d0, 0), Vec3(0, 0.2 * b * d0, 0),
+                                       Vec3(2.2 * d0, 0.5 * b * d0, 0.3 * b * d0), Vec3(-0.5 * d0, 0, 0),
+                                       Vec3(0.2 * d0, 0, 1.3 * b * law.deltaf()), Vec3(0.5 * d0, 0, 0)};
+    double lm = 0.0, work = 0.0, booked = 0.0, worst = 0.0;
+    Vec3 tPrev = computeTraction(law, corners[0], lm);
+    for (std::size_t c = 1; c < corners.size(); ++c) {
+      const int n = 20000;
+      for (int i = 1; i <= n; ++i) {
+        const Vec3 a = corners[c - 1] + (corners[c] - corners[c - 1]) * (double(i - 1) / n);
+        const Vec3 o = corners[c - 1] + (corners[c] - corners[c - 1]) * (double(i) / n);
+        const double before = lm;
+        const Vec3 t = computeTraction(law, o, lm);
+        work += 0.5 * (tPrev + t).dot(o - a);
+        booked += dissipationIncrement(law, o, before, lm);
+        tPrev = t;
+        worst = std::max(worst, std::abs(work - storedEnergyDensity(law, o, lm) - booked));
+      }
+      if (c == 3)  // after the mixed leg: the normal-mode account alone would be off by far more than the error
+        EXPECT_GT(std::abs(work - storedEnergyDensity(law, corners[c], lm) - dissipatedEnergyDensity(law, lm)),
+                  0.05 * law.Gamma) << beta;
+    }
+    EXPECT_TRUE(isFailed(law, lm)) << beta;
+    EXPECT_LT(worst, 2e-4 * law.Gamma) << "beta " << beta << ": work " << work << " booked " << booked;
+    EXPECT_GT(booked, std::min(1.0, beta * beta) * law.Gamma) << beta;
+  }
+}
+
+TEST(Cohesive, MakeLawRejectsBadShearStrengthRatio) {
+  for (double beta : {0.0, -1.0, 10.5, std::numeric_limits<double>::quiet_NaN(),
+                      std::numeric_limits<double>::infinity()}) {
+    try {
+      makeLaw(0.1, 1e-4, 3e-7, 1.0, beta);
+      ADD_FAILURE() << "expected std::invalid_argument for " << beta;
+    } catch (const std::invalid_argument& ex) {
+      EXPECT_NE(std::string(ex.what()).find("shear_strength_ratio"), std::string::npos) << ex.what();
+    }
+  }
+  EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7, 1.0, 10.0));
+  EXPECT_NO_THROW(makeLaw(0.1, 1e-4, 3e-7, 1.0, 1e-3));
+}

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "measurements.hpp"
 #include "simulation.hpp"
@@ -12,27 +14,33 @@ using namespace enamel;
 
 namespace {
 
-CaseParams elasticCase(double theta, double a0OverWs) {
+// `grips`: more case lines (the grips' keys), none by default.
+CaseParams elasticCase(double theta, double a0OverWs, const std::string& grips = "") {
   return parseCase("theta_D = " + std::to_string(theta) +
                        "\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n"
                        "rods_breakable = false\ninterfaces_breakable = false\n"
                        "w_s_over_d = 30\nh_s_over_d = 16\nh_e_over_d = 0.3\n"
-                       "a0_over_ws = " + std::to_string(a0OverWs) + "\n",
+                       "a0_over_ws = " + std::to_string(a0OverWs) + "\n" + grips,
                    "elastic", "", {});
 }
 
-struct Static { double P, J, energy, a; };
+// terms: |sum F_y du_y/dx| + W_right + W_left over B, the boundary terms J is the sum of (J's conditioning)
+struct Static { double P, J, energy, a, terms = 0; };
 
-Static solveAt(double theta, double a0) {
-  Simulation sim(elasticCase(theta, a0 / 30.0));
+Static solveAt(double theta, double a0, const std::string& grips = "") {
+  Simulation sim(elasticCase(theta, a0 / 30.0, grips));
   const double U = 0.01;
   sim.solveStaticElastic(U);
   double P = 0;
   for (std::size_t i = 0; i < sim.ops.prescribedDofs.size(); ++i) P += sim.state.reaction[i] * sim.ops.prescribedShape[i];
   // crack length of the discrete model: midway between the last cut slice and the first intact one
   const int lastCut = static_cast<int>(std::ceil(a0 / sim.model.h_e)) - 1;
+  const Model& m = sim.model;
+  const double terms = (std::abs(sumGripForceTimesSlope(m, sim.ops, sim.state)) +
+                        faceEnergyDensity(m, sim.materials, sim.state, 0, 0) +
+                        faceEnergyDensity(m, sim.materials, sim.state, m.numSlices - 1, 1)) / m.B;
   return {P, sim.computeJ(), sim.strainEnergyOfBeams() + sim.strainEnergyOfInterfaces(),
-          (lastCut + 0.5) * sim.model.h_e};
+          (lastCut + 0.5) * sim.model.h_e, terms};
 }
 
 }  // namespace
@@ -99,3 +107,87 @@ TEST(JIntegral, LoadedFacesTermsMatchAHandComputationWithReactionsAtTheRightEdge
   EXPECT_GT(std::abs(signTest - (top + bottom)), 1e-3 * std::abs(top))
       << "the shape's sign misreads the right-edge bottom grips, so it must differ from the hand value";
 }
+
+// Every grip profile and constraint (case keys grip_profile, grip_constraint): J at the outer boundary, with the
+// loaded faces' slope of each profile, against the compliance and energy release rates of the same grips, as in
+// BoundaryJMatchesComplianceAndEnergyReleaseRates (P the force conjugate to U: sum of reaction x shape), at
+// theta_D = 30. J is the sum of the loaded faces' term and the face energies. With the grips turning to the right
+// edge those terms are about G itself, and J agrees with G within 4% (2.3% for uy, 3.4% for uxuy, measured
+// 2026-12-03). Turning about the centre, the pre-crack tip at a0 = w_s/2 sits where u_y = 0 and the right part
+// of the specimen is compressed: J is then the difference of a loaded faces' term and a right-face energy each
+// 20-30 G, and their discretisation error, a few percent of them (1.8% for uy, 6.4% for uxuy), is most of G
+// (J/G = 0.26 and -0.83): the outer-boundary J does not measure G there, and the test states that conditioning
+// and bounds the error by 10% of the terms rather than claiming agreement (docs/model.md, Loading). The grips
+// do change the specimen's compliance (each case tests its own shape and slope, not the default's).
+TEST(JIntegral, BoundaryJAgainstComplianceForEveryGripProfileAndConstraint) {
+  const double theta = 30.0, B = std::sqrt(3.0), U = 0.01;
+  const double defaultP = solveAt(theta, 15.05).P;
+  for (const char* profile : {"to_right_edge", "about_centre"})
+    for (const char* constraint : {"uy", "uxuy"}) {
+      const std::string grips = std::string("grip_profile = \"") + profile + "\"\ngrip_constraint = \"" + constraint + "\"\n";
+      const Static lo = solveAt(theta, 13.55, grips), mid = solveAt(theta, 15.05, grips), hi = solveAt(theta, 16.55, grips);
+      const double da = hi.a - lo.a;
+      const double Gcompliance = mid.P * mid.P / (2 * B) * (U / hi.P - U / lo.P) / da;
+      const double Genergy = -(hi.energy - lo.energy) / da / B;
+      const std::string what = std::string(profile) + " " + constraint + ": J/G_c " +
+                               std::to_string(mid.J / Gcompliance) + " terms/G_c " +
+                               std::to_string(mid.terms / Gcompliance);
+      EXPECT_NEAR(mid.energy, 0.5 * mid.P * U, 1e-9 * mid.energy) << what << ": Clapeyron";
+      EXPECT_NEAR(Genergy / Gcompliance, 1.0, 0.03) << what;
+      if (std::string(profile) == "to_right_edge") {
+        EXPECT_LT(mid.terms, 1.2 * Gcompliance) << what << ": J is well conditioned";
+        EXPECT_GT(mid.J, 0) << what;
+        EXPECT_NEAR(mid.J / Gcompliance, 1.0, 0.04) << what;
+        EXPECT_NEAR(mid.J / Genergy, 1.0, 0.04) << what;
+      } else {
+        EXPECT_GT(mid.terms, 10.0 * Gcompliance) << what << ": J is the difference of terms much larger than G";
+        EXPECT_NEAR(mid.J, Gcompliance, 0.1 * mid.terms) << what;
+        EXPECT_NEAR(mid.J, Genergy, 0.1 * mid.terms) << what;
+      }
+      if (std::string(profile) != "to_right_edge" || std::string(constraint) != "uy")
+        EXPECT_GT(std::abs(mid.P / defaultP - 1.0), 0.01) << what << ": the grips change the compliance";
+    }
+}
+
+// The loaded faces' terms by hand for the rotation about the centre with u_x held: du_y/dx = -2U/w_s on the top
+// row, +2U/w_s on the bottom row (taken from the row lists), and the u_x grips add nothing (du_x/dx = 0 along
+// the faces) though they carry a reaction; their shape is 0, so they do no work and add nothing to P.
+TEST(JIntegral, LoadedFacesTermsAboutTheCentreWithUxHeld) {
+  Simulation sim(parseCase("theta_D = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n"
+                           "rods_breakable = false\ninterfaces_breakable = false\n"
+                           "w_s_over_d = 6\nh_s_over_d = 4\nh_e_over_d = 0.3\n"
+                           "grip_profile = \"about_centre\"\ngrip_constraint = \"uxuy\"\n",
+                           "small", "", {}));
+  const Model& m = sim.model;
+  const Operators& ops = sim.ops;
+  const double U = 0.02;
+  sim.solveStaticElastic(U);
+  ASSERT_EQ(ops.prescribedDofs.size(), 2 * (m.topNodes.size() + m.bottomNodes.size()));
+  auto indexOf = [&](int dof) {
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i)
+      if (ops.prescribedDofs[i] == dof) return i;
+    ADD_FAILURE() << "DOF " << dof << " is not prescribed";
+    return std::size_t(0);
+  };
+  double hand = 0, xReactions = 0;
+  for (const auto& [nodes, sign] : {std::make_pair(&m.topNodes, 1.0), std::make_pair(&m.bottomNodes, -1.0)})
+    for (int node : *nodes) {
+      const std::size_t iy = indexOf(6 * node + 1), ix = indexOf(6 * node);
+      EXPECT_EQ(ops.prescribedShape[iy], sign * (1.0 - 2.0 * (m.X[node].x() / m.w_s)));
+      EXPECT_EQ(sim.state.q[6 * node + 1], ops.prescribedShape[iy] * U);
+      EXPECT_EQ(sim.state.q[6 * node], 0.0);
+      EXPECT_EQ(ops.prescribedShape[ix], 0.0);
+      hand += sim.state.reaction[iy] * (-sign * 2.0 * U / m.w_s);
+      xReactions += std::abs(sim.state.reaction[ix]);
+    }
+  EXPECT_GT(xReactions, 1e-6 * std::abs(hand) * m.w_s / U) << "the u_x grips carry a reaction";
+  EXPECT_NEAR(sumGripForceTimesSlope(m, ops, sim.state), hand, 1e-12 * std::abs(hand));
+  const double Wleft = faceEnergyDensity(m, sim.materials, sim.state, 0, 0);
+  const double Wright = faceEnergyDensity(m, sim.materials, sim.state, m.numSlices - 1, 1);
+  EXPECT_NEAR(sim.computeJ(), (-hand + Wright - Wleft) / m.B, 1e-12 * std::abs(hand) / m.B);
+  double P = 0;
+  for (int node : m.topNodes) P += sim.state.reaction[indexOf(6 * node + 1)] * (1.0 - 2.0 * m.X[node].x() / m.w_s);
+  for (int node : m.bottomNodes) P -= sim.state.reaction[indexOf(6 * node + 1)] * (1.0 - 2.0 * m.X[node].x() / m.w_s);
+  EXPECT_NEAR(computeGripLoad(ops, sim.state), P, 1e-12 * std::abs(P));
+}
+

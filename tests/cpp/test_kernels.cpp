@@ -165,8 +165,9 @@ TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
 // The scheduled interface pass (InterfaceSchedule) along a path that fails some interfaces and comes back: the
 // same histories and failed counts as evaluating every interface by the law, forces within round-off of it;
 // a schedule started afresh part-way (a restart) gives the same forces bit for bit; no thread count matters.
-TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) {
-  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+// `keys`: further case keys (the mixed-mode law's shear_strength_ratio, whose lambda weighs shear by 1/beta^2).
+static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n" + keys));
   const Model& m = sim.model;
   const cohesive::Law& law = sim.materials.law;
   const int n = m.numDofs();
@@ -202,6 +203,15 @@ TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) {
   for (double lm : lmLaw) failed += cohesive::isFailed(law, lm);
   EXPECT_GT(failed, 0) << "the path should fail some interfaces";
   EXPECT_LT(evaluated, static_cast<long>(steps + 1) * m.numInterfaces()) << "the schedule should skip some";
+}
+
+TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) { checkScheduledInterfacePassFollowsTheLaw(""); }
+// A weak shear (beta < 1) makes lambda grow faster than the opening's norm: the schedule must bound that.
+TEST(Kernels, ScheduledInterfacePassFollowsTheMixedModeLawWeakShear) {
+  checkScheduledInterfacePassFollowsTheLaw("shear_strength_ratio = 0.5\n");
+}
+TEST(Kernels, ScheduledInterfacePassFollowsTheMixedModeLawStrongShear) {
+  checkScheduledInterfacePassFollowsTheLaw("shear_strength_ratio = 2\n");
 }
 
 // K in node blocks (node_blocks.hpp) against Eigen's sparse product: the rods lie in xy-planes, so the model's

@@ -1,5 +1,5 @@
 """Command line: --help on every command, and bad input answered by one clear line and a distinct exit
-status before anything is allocated or written (issues "Foundation" and "Hard cases and faults")."""
+status before anything is allocated or written (docs/verification.md)."""
 import os
 import re
 import subprocess
@@ -57,6 +57,20 @@ def test_bad_case_file_one_clear_line(run, tmp_path, text, status, words):
     for w in words:
         assert w in lines[0], (w, lines[0])
     assert not out.exists(), "nothing may be written before the case is valid"
+
+
+@pytest.mark.parametrize("text, status, words", [
+    (GOOD + "shear_strength_ratio = 0\n", OUT_OF_RANGE, ["'shear_strength_ratio'", "= 0", "(0, 10]"]),
+    (GOOD + "shear_strength_ratio = 12\n", OUT_OF_RANGE, ["'shear_strength_ratio'", "= 12", "(0, 10]"]),
+    (GOOD + 'shear_strength_ratio = "2"\n', WRONG_TYPE, ["'shear_strength_ratio'", '"2"', "wrong type", "(0, 10]"]),
+    (GOOD + 'grip_constraint = "ux"\n', OUT_OF_RANGE, ["'grip_constraint'", '"ux"', '"uy", "uxuy"']),
+    (GOOD + 'grip_profile = "centre"\n', OUT_OF_RANGE,
+     ["'grip_profile'", '"centre"', '"to_right_edge", "about_centre"']),
+])
+def test_bad_model_reading_key_one_clear_line(run, tmp_path, text, status, words):
+    """The keys of the paper's open readings (docs/model.md, Choices the paper leaves open): one line naming the
+    key, the value and what is allowed, before anything is written."""
+    test_bad_case_file_one_clear_line(run, tmp_path, text, status, words)
 
 
 def test_missing_case_file(run, tmp_path):

@@ -70,3 +70,31 @@ def test_a_check_against_an_unfinished_run_says_so(tmp_path):
     data, readme = write(tmp_path, [record(n(40, 10), 40, 10, 6.5), short])
     text = square.report(data, readme)
     assert "**same** (over the common range: s40_he0.15_G10 interrupted)" in text and "| (0,14.8] |" in text
+
+
+def test_validation_cases_are_named_and_judged_at_the_selected_G(tmp_path):
+    n = square.run_name
+    assert n(80, 9) == "s80_he0.3_G9" and n(80, 9, case="theta15_s21.4_e10_cv0") == "theta15_s21.4_e10_cv0_s80_he0.3_G9"
+    converged = [record(n(80, 10), 80, 10, 6.6), record(n(100, 10), 100, 10, 6.8), record(n(40, 10), 40, 10, 6.5),
+                 record(n(40, 10, he=0.15), 40, 10, 6.9, he=0.15), record(n(80, 10, rate=0.5), 80, 10, 6.65, rate=0.5)]
+    val = []
+    for case, lvl in (("theta15_s21.4_e10_cv0", 7.3), ("theta0_s21.4_e10_cv0", 1.5),
+                      ("theta30_s7.1_e10_cv0", 2.0), ("theta30_s28.5_e10_cv0", 9.0)):
+        r = record(n(80, 10, case=case), 80, 10, lvl)
+        r["case"] = case
+        val.append(r)
+    val[1]["R_init"] = 1.35                       # theta_D = 0: R_init within 3% of 4/3, the level 12% above it
+    val[0]["rod_da"] = [5.0, 6.0]                  # theta15: no rod break before 3.86 d
+    converged[1]["rod_da"] = [0.3, 4.0]            # theta30 at 100 d: a rod break before 2 d
+    data, readme = write(tmp_path, converged + val)
+    text = square.report(data, readme)
+    assert "**Selected by the records so far: G = 10**" in text      # the validation cases do not enter the rule
+    line = {l.split(":")[0].strip("| "): l for l in text.splitlines() if l.startswith("| fig")}
+    assert "| reproduced (+4.0%; tolerance 20%) |" in line["fig4_theta15_R_ss"]  # (5,25] mean of the test curve 7.28
+    assert "| reproduced |" in line["fig4_theta15_no_rod_fracture_before_crisscross"]
+    assert "reproduced (+1.3%; tolerance 3%)" in line["fig4_theta0_R_init"]
+    assert "**not reproduced**" in line["fig4_theta0_R_ss"] and "tolerance 3%" in line["fig4_theta0_R_ss"]
+    assert "not a validation" in line["fig4_theta30_R_ss"] and "**not reproduced**" in line[
+        "fig4_theta30_no_rod_fracture_before_crisscross"]
+    rod_strength = [l for l in text.splitlines() if l.startswith("| fig5_R_ss_increases_with_rod_strength")]
+    assert len(rod_strength) == 1 and "| 7.1: 1.98, 21.4: 6.78, 28.5: 8.98 | holds |" in rod_strength[0]

@@ -1,4 +1,4 @@
-"""pipeline/export_vtk.py (issues "Pipeline and figures" and 18, item 5): the ParaView files, read back with VTK's
+"""pipeline/export_vtk.py: the ParaView files, read back with VTK's
 own reader (vtkXMLUnstructuredGridReader; the .pvd collection is plain XML), have one line cell per rod element
 and one quad per interface, the arrays that --help promises with the values of the HDF5 file, one time point per
 distinct frame, and interface quads that are the interfaces' faces: area = /geometry/iface_area, planar, normal
