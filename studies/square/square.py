@@ -31,6 +31,11 @@ RUNS = paths.RUNS / "square"
 CASE = "theta30_s21.4_e10_cv0"
 PAPER_LEVEL = 7.0            # the paper's R/Gamma_i "at Delta_a ~ 15 d" for this case (the rule's target)
 SELECT_WINDOW = (5.0, 25.0)  # the rule's mean
+# The paper's open readings (the rule's second part), each a case key whose default is today's reading.
+READING_KEYS = ("shear_strength_ratio", "grip_constraint", "grip_profile", "crisscross_phase")
+READING_FIRST_BREAK = 2.0    # the paper: no rod break before the first crisscross point, d/sin(theta_D) = 2 d
+READING_LEVEL_TOL = 0.15     # and the (5,25] mean kept within 15% of PAPER_LEVEL
+READING_MIN_SIZE = 80.0      # at a converged size (80 x 80 d and larger)
 NUMERICS = {"integrator": '"lumped"', "dt_factor": "0.22", "damping_cap": "0.5", "static_start": "0.95"}
 
 
@@ -72,6 +77,8 @@ def record_of(run_dir: pathlib.Path, name: str) -> dict:
     r = results.load_result(path)
     rec["params"] = {k: r.param(k) for k in ("w_s_over_d", "h_s_over_d", "h_e_over_d", "Gamma_k_over_sigma0sq",
                                              "rate_factor")}
+    rec["readings"] = {k: (str(r.params[k]) if isinstance(r.params[k], (str, bytes)) else float(r.params[k]))
+                       for k in READING_KEYS if k in r.params}
     rec["rod_da"] = [float(f"{x:.6g}") for x in rod_breaks(path)]
     rec["cpu"] = records.cpu_model()
     return rec
@@ -256,6 +263,55 @@ def validation(recs: dict, G: float) -> list[str]:
     return lines + (["", "| trend | series | points (x: y) | verdict |", "|---|---|---|---|"] + rows if rows else [])
 
 
+def reading_of(rec: dict) -> str:
+    """What a record changes from today's readings ("today's" when nothing), from the keys it recorded."""
+    changed = [f"{k} = {v}" for k, v in rec.get("readings", {}).items()
+               if v != READING_DEFAULTS.get(k, v)]
+    return ", ".join(changed) if changed else "today's"
+
+
+READING_DEFAULTS = {"shear_strength_ratio": 1.0, "grip_constraint": "uy", "grip_profile": "to_right_edge",
+                    "crisscross_phase": 0.0}
+
+
+def readings(recs: dict, G: float) -> list[str]:
+    """The rule's second part at G: every theta30 (21.4, 10) run at G, h_e 0.3 and the preset's rate (today's
+    readings and each changed one), with its first rod break and (5,25] mean. A reading qualifies when its first
+    rod break is at or past READING_FIRST_BREAK and its mean within READING_LEVEL_TOL of PAPER_LEVEL."""
+    lines = [f"At G = {G:g}, theta30 (21.4, 10), h_e 0.3, the preset's rate. A reading qualifies (README, Selection "
+             f"rule) when the first rod break is at or past {READING_FIRST_BREAK:g} d and the (5,25] mean within "
+             f"{READING_LEVEL_TOL:.0%} of {PAPER_LEVEL:g} ({PAPER_LEVEL * (1 - READING_LEVEL_TOL):.2f} to "
+             f"{PAPER_LEVEL * (1 + READING_LEVEL_TOL):.2f}).", "",
+             "| reading | run | size | first rod break | >= 2 d | **(5,25]** | within 15% of 7 | R_init | broken rods | qualifies |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    rows = []
+    for name, rec in recs.items():
+        p = rec["params"]
+        if not (p["Gamma_k_over_sigma0sq"] == G and p["h_e_over_d"] == 0.3 and p["rate_factor"] == 1.0
+                and p["w_s_over_d"] >= READING_MIN_SIZE and rec.get("case", CASE) == CASE
+                and rec["meta"].get("status") == "completed"):
+            continue
+        plain = name == run_name(p["w_s_over_d"], G)
+        if not plain and "readings" not in rec:
+            continue    # a run with a change the record does not name: not a reading
+        fb, lv = ours(rec, "da_first_rod_fracture_over_d"), level(rec, *SELECT_WINDOW)
+        breaks_late = fb >= READING_FIRST_BREAK
+        near = abs(lv - PAPER_LEVEL) <= READING_LEVEL_TOL * PAPER_LEVEL
+        what = "today's" if plain else reading_of(rec)
+        verdict = "-" if what == "today's" else ("**yes**" if breaks_late and near else "no")
+        rows.append((what != "today's", what, p["w_s_over_d"], name,
+                     f"| {what} | {name} | {p['w_s_over_d']:g} d | {fmt(fb)} | {'yes' if breaks_late else 'no'} | "
+                     f"**{fmt(lv)}** | {'yes' if near else 'no'} ({pct((lv - PAPER_LEVEL) / PAPER_LEVEL)}) | "
+                     f"{rec['R_init']:.3g} | {rec['broken_rods']} | "
+                     f"{verdict} |"))
+    if not any(r[0] for r in rows):
+        return []
+    good = [r[1] for r in rows if r[-1].endswith("| **yes** |")]
+    end = (f"**Qualifying so far: {'; '.join(good)}.**" if good else
+           "**No reading run so far qualifies: today's readings stay.**")
+    return lines + [r[-1] for r in sorted(rows)] + ["", end]
+
+
 def figure(recs: dict, out: pathlib.Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
@@ -288,6 +344,8 @@ def report(data: pathlib.Path = DATA, readme: pathlib.Path = HERE / "README.md")
     lines += run_rows(recs) + ["", "### Convergence checks (the measure; L2 and windows reported only)", ""]
     lines += PAIR_HEAD + [compare_line(*c[:3], recs, c[3])[0] for c in checks]
     lines += ["", "### Selection", ""] + chosen + [""]
+    if G is not None and readings(study, G):   # (none until a changed reading has run)
+        lines += ["### Readings (the selection rule's second part)", ""] + readings(study, G) + [""]
     if G is not None:
         lines += ["### Validation (reported, never fitted)", ""] + validation(recs, G) + [""]
     if study:

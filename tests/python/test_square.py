@@ -98,3 +98,26 @@ def test_validation_cases_are_named_and_judged_at_the_selected_G(tmp_path):
         "fig4_theta30_no_rod_fracture_before_crisscross"]
     rod_strength = [l for l in text.splitlines() if l.startswith("| fig5_R_ss_increases_with_rod_strength")]
     assert len(rod_strength) == 1 and "| 7.1: 1.98, 21.4: 6.78, 28.5: 8.98 | holds |" in rod_strength[0]
+
+
+def test_a_reading_qualifies_only_with_a_late_first_break_and_the_level_kept(tmp_path):
+    n = square.run_name
+    base = [record(n(80, 10), 80, 10, 6.6), record(n(100, 10), 100, 10, 6.8),
+            record(n(40, 10), 40, 10, 6.5), record(n(40, 10, he=0.15), 40, 10, 6.9, he=0.15),
+            record(n(80, 10, rate=0.5), 80, 10, 6.65, rate=0.5)]
+    late_high = record(n(80, 10, extra="beta0.5"), 80, 10, 10.0, rods=(3.1, 5, 7))      # +43%: level lost
+    late_high["readings"] = dict(square.READING_DEFAULTS, shear_strength_ratio=0.5)
+    early = record(n(80, 10, extra="phase0.9"), 80, 10, 7.0, rods=(1.8, 4))             # breaks before 2 d
+    early["readings"] = dict(square.READING_DEFAULTS, crisscross_phase=0.9)
+    data, readme = write(tmp_path, base + [late_high, early])
+    text = square.report(data, readme)
+    rows = {line.split(" | ")[1]: line for line in text.splitlines() if line.startswith("| ") and "_G10" in line}
+    assert "shear_strength_ratio = 0.5 |" in rows[n(80, 10, extra="beta0.5")]
+    assert rows[n(80, 10, extra="beta0.5")].endswith("| no |") and rows[n(80, 10, extra="phase0.9")].endswith("| no |")
+    assert n(40, 10) not in [r for r in rows if "today's" in rows[r]]             # 40 d is not a converged size
+    assert "**No reading run so far qualifies: today's readings stay.**" in text
+    good = record(n(80, 10, extra="uxuy"), 80, 10, 7.5, rods=(2.2, 4))
+    good["readings"] = dict(square.READING_DEFAULTS, grip_constraint="uxuy")
+    (tmp_path / "two").mkdir()
+    data2, readme2 = write(tmp_path / "two", base + [late_high, early, good])
+    assert "**Qualifying so far: grip_constraint = uxuy.**" in square.report(data2, readme2)
