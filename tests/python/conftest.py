@@ -74,16 +74,16 @@ def checkpoint_stamp(out):
         return None
 
 
-def run_with_kills(enamel, out, args, delays, timeout=900):
+def run_with_kills(enamel, out, args, delays, timeout=900, every=0.1):
     """Run enamel-dem to completion in `out`, killed with SIGKILL once per entry of `delays`: each piece is killed
     `delay` s after it wrote a checkpoint of its own (so every kill lands between checkpoints whatever the
     machine's speed), and the next piece continues it with --restart. args(extra) gives the solver's arguments
-    with `extra` (the checkpoint interval, --restart) appended. Returns the number of kills that landed (fewer
+    with `extra` (the checkpoint interval `every` s, --restart) appended. Returns the number of kills that landed (fewer
     than len(delays) when a piece finished first)."""
     kills = 0
     for delay in list(delays) + [None]:
         before = checkpoint_stamp(out)
-        extra = ["--checkpoint-every", "0.1"] + (["--restart"] if kills else [])
+        extra = ["--checkpoint-every", str(every)] + (["--restart"] if kills else [])
         p = subprocess.Popen([str(enamel), *map(str, args(extra))], stderr=subprocess.PIPE, text=True)
         if delay is not None:
             while p.poll() is None and checkpoint_stamp(out) in (None, before):
