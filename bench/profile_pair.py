@@ -24,10 +24,11 @@ from enamel_results import paths
 
 HEAD = re.compile(r"(\d+) DOF, (\d+) thread\(s\), (\d+) steps per kernel.*?: ([0-9.eE+-]+) s/step, ([0-9.]+) M DOF-updates/s")
 KERNELS = ("step", "advance", "interfaces", "nodes", "check and rest")
+MEDIAN_KEYS = ("s_per_step", "mdofs_per_core", *KERNELS[1:])
 
 
-def profile_args(binary: str, threads: int, steps: int) -> list[str]:
-    args = [binary, "profile", str(paths.PAPER_CASES / f"{PROFILE_CASE}.toml"), "--preset", "paper",
+def profile_args(binary: str, threads: int, steps: int, preset: str = "paper") -> list[str]:
+    args = [binary, "profile", str(paths.PAPER_CASES / f"{PROFILE_CASE}.toml"), "--preset", preset,
             "--steps", str(steps)]
     for k, v in dict(PROFILE_SETS, threads=threads).items():
         args += ["--set", f"{k}={v}"]
@@ -47,6 +48,19 @@ def parse(text: str) -> dict:
     return out
 
 
+def medians(rounds: list[tuple[dict, dict]]) -> dict:
+    """{'old': {key: median}, 'new': {key: median}} over the rounds' (old, new) parses, for s/step, DOF-updates/s
+    per core and each kernel but the step (a round whose profile lacks a kernel is left out of its median)."""
+    return {name: {k: statistics.median(pair[j][k] for pair in rounds if k in pair[j]) for k in MEDIAN_KEYS}
+            for j, name in enumerate(("old", "new"))}
+
+
+def ratios(med: dict) -> dict:
+    """new / old of the medians, per key: of times for s_per_step and the kernels (< 1: faster), of speeds for
+    mdofs_per_core (the speed-up)."""
+    return {k: med["new"][k] / med["old"][k] for k in MEDIAN_KEYS}
+
+
 def version(binary: str) -> str:
     return subprocess.run([binary, "--version"], capture_output=True, text=True).stdout.strip()
 
@@ -64,12 +78,12 @@ def report(old: str, new: str, rounds: list[tuple[dict, dict]], threads: int) ->
         for name, p in zip(("old", "new"), pair):
             lines.append(f"| {i} | {name} | {p['s_per_step']:.4g} | {p['mdofs_per_core']:.1f} | "
                          + " | ".join(f"{p.get(k, float('nan')):.4g}" for k in KERNELS[1:]) + " |")
-    med = {name: {k: statistics.median(pair[j][k] for pair in rounds if k in pair[j])
-                  for k in ("s_per_step", "mdofs_per_core", *KERNELS[1:])} for j, name in enumerate(("old", "new"))}
+    med = medians(rounds)
+    ratio = ratios(med)
     lines += ["", "| median | old | new | new / old (time) |", "|---|---|---|---|"]
     for k in ("s_per_step", *KERNELS[1:]):
-        lines.append(f"| {k} | {med['old'][k]:.4g} | {med['new'][k]:.4g} | {med['new'][k] / med['old'][k]:.3f} |")
-    speedup = med["new"]["mdofs_per_core"] / med["old"]["mdofs_per_core"]
+        lines.append(f"| {k} | {med['old'][k]:.4g} | {med['new'][k]:.4g} | {ratio[k]:.3f} |")
+    speedup = ratio["mdofs_per_core"]
     lines += ["", f"**DOF-updates/s per core: {med['old']['mdofs_per_core']:.1f} M (old) -> "
                   f"{med['new']['mdofs_per_core']:.1f} M (new), {speedup:.2f}x** (medians of the rounds).", ""]
     return "\n".join(lines)
