@@ -4,11 +4,11 @@
 #   make build    configure and build the solver and the C++ tests (Release)
 #   make test     all C++ and Python tests (runs deps and build first when needed)
 #
-#   make figures  [PRESET=ci|reduced|paper] [JOBS=N]  every run of Figs. 4-9, then the figures and the summary
+#   make figures  [PRESET=ci|reduced|converged|paper] [JOBS=N]  every run of Figs. 4-9, then the figures and the summary
 #                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
 #                 number of cores). A run that was stopped continues from its checkpoint.
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
-#                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=8"): --set on every run, in a runs
+#                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=3"): --set on every run, in a runs
 #                 folder and a figures folder of their own (runs/set_<keys>/, figures/out/set_<keys>/)
 #   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
 #                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
@@ -60,7 +60,7 @@ PYTHON ?= $(shell for p in /usr/bin/python3 python3; do \
 
 ENAMEL := $(BUILD_DIR)/enamel-dem
 PRESET ?= reduced
-PRESETS := ci reduced paper
+PRESETS := ci reduced converged paper
 # Where the runs and the figures go. RUN_SET (below) changes the runs' physics or numerics, which Make does not
 # track, so a RUN_SET without RUNS on the command line gets a folder of its own, named after it:
 #   make figures RUN_SET="Gamma_k_over_sigma0sq=8"  ->  runs/set_Gamma_k_over_sigma0sq-8/<preset>/<case>/result.h5,

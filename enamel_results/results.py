@@ -20,6 +20,37 @@ from enamel_results.cases import params_from_name
 from enamel_results.constants import EXIT
 
 
+# Size convergence (docs/results.md): at the default interface ductility Gamma_i k/sigma0^2 = 10 the theta30 R-curve
+# is the same (enamel_results.metrics.same_rcurve) at 80 x 80 d and 100 x 100 d, and at h_e 0.3 against 0.15 d;
+# smaller specimens, and any other G, are not shown converged.
+CONVERGED_SIZE_OVER_D = 80.0
+CONVERGED_H_E_OVER_D = 0.3
+CONVERGED_G = 10.0
+
+
+def size_converged(r: "Result") -> bool:
+    """Whether r's specimen is as large as the size shown converged, at that mesh and at the G where it was shown."""
+    p = r.params
+    return (float(p["w_s_over_d"]) >= CONVERGED_SIZE_OVER_D and float(p["h_s_over_d"]) >= CONVERGED_SIZE_OVER_D
+            and float(p["h_e_over_d"]) <= CONVERGED_H_E_OVER_D
+            and float(p["Gamma_k_over_sigma0sq"]) == CONVERGED_G)
+
+
+def convergence_label(results) -> str:
+    """One phrase for a set of runs: size-converged, or not and why (the sizes and G they ran at)."""
+    rs = list(results)
+    if not rs:
+        return "no runs"
+    if all(size_converged(r) for r in rs):
+        return "size-converged"
+    sizes = sorted({(float(r.params["w_s_over_d"]), float(r.params["h_s_over_d"])) for r in rs})
+    gs = sorted({float(r.params["Gamma_k_over_sigma0sq"]) for r in rs})
+    size_text = ", ".join(f"{w:g} x {h:g} d" for w, h in sizes)
+    g_text = ", ".join(f"{g:g}" for g in gs)
+    return (f"NOT size-converged ({size_text}, G = {g_text}; converged from "
+            f"{CONVERGED_SIZE_OVER_D:g} x {CONVERGED_SIZE_OVER_D:g} d at G = {CONVERGED_G:g})")
+
+
 EXIT_CODES = EXIT   # {name: status}, read from the solver's one definition (enamel_results.constants)
 EXIT_MISSING = EXIT_CODES["missing_file"]      # a result file is missing
 EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or fails its checksum

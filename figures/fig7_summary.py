@@ -70,7 +70,7 @@ def main():
                frameon=False)
     missing = len(names) - len(results)
     fig.suptitle(f"Fig. 7: $R_{{init}}$ and $R_{{ss}}$ against $\\theta_D$, $\\sigma_{{ru}}/\\sigma_0$ and $E_r/kd$ "
-                 f"(preset {args.preset}, {len(results)} runs" + (f", {missing} missing" if missing else "") + ")",
+                 f"({plotting.preset_text(args.preset, results.values())}, {len(results)} runs" + (f", {missing} missing" if missing else "") + ")",
                  fontsize=11)
     plotting.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
 

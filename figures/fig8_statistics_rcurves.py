@@ -45,7 +45,7 @@ def main():
     fig.legend(handles=plotting.map_legend_handles(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=5,
                fontsize=8, frameon=False)
     fig.suptitle("Fig. 8: effect of the rod-strength coefficient of variation ($\\bar\\sigma_{ru}/\\sigma_0$ = 28.5, "
-                 f"$\\theta_D$ = 30°, $E_r/kd$ = 10) (preset {args.preset}; maps at the frame nearest "
+                 f"$\\theta_D$ = 30°, $E_r/kd$ = 10)\n({plotting.preset_text(args.preset, results.values())}; maps at the frame nearest "
                  f"$\\Delta a/d$ = {da:g})", fontsize=11)
     plotting.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
 

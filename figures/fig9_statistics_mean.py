@@ -52,7 +52,7 @@ def main():
     ax.set_ylabel("merged crack resistance $\\bar R_m/\\Gamma_i$ ($0 < \\Delta a/d < 30$)")
     ax2.set_ylabel("spread $\\Delta R_m/\\Gamma_i$ (standard deviation)")
     fig.suptitle(f"Fig. 9: merged crack resistance against cv ($\\bar\\sigma_{{ru}}/\\sigma_0$ = 28.5, "
-                 f"$\\theta_D$ = 30°, $E_r/kd$ = 10; preset {args.preset})", fontsize=11)
+                 f"$\\theta_D$ = 30°, $E_r/kd$ = 10)\n({plotting.preset_text(args.preset, results.values())})", fontsize=11)
     plotting.save(fig, args.preset, pathlib.Path(__file__).stem, args.out)
 
 

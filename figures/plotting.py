@@ -17,7 +17,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from enamel_results import cases, cli, paths  # noqa: E402
 from enamel_results.paper_values import (RELATION_SYMBOL, paper_value_text, paper_values, snapshot_da,  # noqa: E402
                                          values_for_case)
-from enamel_results.results import TAG_INTER12, TAG_PLY1, TAG_PLY2, Frame, Result  # noqa: E402
+from enamel_results.results import TAG_INTER12, TAG_PLY1, TAG_PLY2, Frame, Result, convergence_label  # noqa: E402
 
 # The map panels drawn from the interface tags.
 MAP_PANELS = (  # (title, interface tag, node_ply of the rod elements drawn, None: none)
@@ -173,6 +173,12 @@ def title_with_status(ax, text: str, r: Result) -> None:
     ax.set_title(text + flag, fontsize=9, color="red" if flag else "black")
 
 
+def preset_text(preset: str, results) -> str:
+    """'preset ci, NOT size-converged (...)' for a figure's title: which preset, and whether its runs are
+    size-converged (enamel_results.results.size_converged)."""
+    return f"preset {preset}, {convergence_label(results)}"
+
+
 def map_figure(script: str, fig_key: str, description: str, row_keys: tuple, suptitle: str) -> None:
     """Figs. 4, 5, 6: one row per case of the figure's table (figures/figN_<name>.toml): three process-zone maps and the R-curve,
     with the half-rate twin and the paper's numbers on the R-curve."""
@@ -198,6 +204,7 @@ def map_figure(script: str, fig_key: str, description: str, row_keys: tuple, sup
         ax.legend(fontsize=7, loc="best")
     fig.legend(handles=map_legend_handles(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=5, fontsize=8,
                frameon=False)
-    fig.suptitle(f"{suptitle} (preset {args.preset}; maps at the frame nearest $\\Delta a/d$ = {da:g})",
+    fig.suptitle(f"{suptitle} ({preset_text(args.preset, results.values())};\nmaps at the frame nearest "
+                 f"$\\Delta a/d$ = {da:g})",
                  fontsize=11)
     save(fig, args.preset, pathlib.Path(script).stem, args.out)

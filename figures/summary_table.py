@@ -15,6 +15,7 @@ import math
 import sys
 
 from enamel_results import cases, cli, metrics, paper_values, paths
+from enamel_results.results import convergence_label
 
 PARAMS = ("theta_D", "sigma_ru_over_sigma0", "Er_over_kd", "cv", "seed")
 OURS = (("da_max_over_d", "da_max"), ("R_init_over_Gamma", "R_init"), ("R_ss_over_Gamma", "R_ss"),
@@ -173,6 +174,7 @@ def write_markdown(path, preset, rows, results, pv, trends):
         return "%.4g" % float(v) if col != "wall_time_s" else "%.0f" % float(v)
 
     lines = [f"# Summary of the {preset} preset runs", "", overrides_line(results), "",
+             f"Size convergence: {convergence_label(results.values())} (docs/results.md).", "",
              "R normalised by Gamma_i, crack advance by d. R_init: first R with Delta_a > 0; R_ss: mean R over "
              "the last 20% of the advance reached (the paper: R at Delta_a/d ~ 30); R_m, Delta R_m: mean and "
              "standard deviation of R over 0 < Delta_a/d < 30 of this run. `paper` columns: the values the paper "

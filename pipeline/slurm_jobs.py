@@ -183,7 +183,7 @@ echo "figures $figures:" {then} "once every task of $array has succeeded; log $h
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--preset", required=True, help="preset of the runs (ci, reduced, paper)")
+    ap.add_argument("--preset", required=True, help="preset of the runs (ci, reduced, converged, paper)")
     ap.add_argument("--cases", nargs="*", metavar="RUN", default=None,
                     help="only these runs of the figure set (<case> or <case>_slow); with --cases there is no "
                          "figures job unless --then gives one")

@@ -39,7 +39,7 @@ struct CaseArgs {
   void addTo(CLI::App* cmd) {
     cmd->add_option("case", casePath, "case file (TOML); 'enamel-dem keys' lists every key")->required();
     cmd->add_option("--preset,-p", preset,
-                    "size preset: ci | reduced | paper (specimen size, mesh, loading rate, stop criterion); "
+                    "size preset: ci | reduced | converged | paper (specimen size, mesh, loading rate, stop criterion); "
                     "precedence: key defaults < preset < case file < --set");
     cmd->add_option("--set,-s", sets, "override one key, as key=value (TOML value), repeatable");
   }

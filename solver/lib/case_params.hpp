@@ -53,9 +53,9 @@ enum class Need { required, optional };
     X(cv, Real, physics, optional, 0, "[)", 0, 1, "", "-",                                                          \
       "strength scatter: coefficient of variation of rod-element strength (normal distribution, "                   \
       "negative draws redrawn)")                                                                                    \
-    X(Gamma_k_over_sigma0sq, Real, physics, optional, 3, "[]", 1, 1e4, "", "sigma0^2/k",                            \
+    X(Gamma_k_over_sigma0sq, Real, physics, optional, 10, "[]", 1, 1e4, "", "sigma0^2/k",                           \
       "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "                        \
-      "fracture length)")                                                                                           \
+      "fracture length; 10 = identified on size-converged specimens, docs/model.md)")                             \
     X(softening_over_delta0, Real, physics, optional, 1, "(]", 0, 2e4, "", "delta0",                               \
       "interface softening length: (delta_f - delta1)/delta0, the length of the trapezoid's linear drop at "      \
       "fixed Gamma_i (plateau end delta1 = Gamma_i/sigma0 + (delta0 - L)/2); 1 = the symmetric trapezoid, "        \
@@ -170,7 +170,7 @@ enum class Need { required, optional };
     X(checkpoint_interval_s, Real, numerics, optional, 0, "[]", 0, 1e7, "", "s (wall clock)",                       \
       "checkpoint interval: wall-clock seconds between checkpoints; 0 = none")
 
-// Names of the built-in presets, in order of size: "ci", "reduced", "paper".
+// Names of the built-in presets, in order of size: "ci", "reduced", "converged", "paper".
 std::vector<std::string> presetNames();
 
 // One plain field per row of ENAMEL_CASE_KEYS, holding the key's default (required keys: 0) until

@@ -81,7 +81,7 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.Er_over_kd, 10.0);
     EXPECT_EQ(p.sigma_ru_over_sigma0, 21.4);
     EXPECT_EQ(p.cv, 0.0);
-    EXPECT_EQ(p.Gamma_k_over_sigma0sq, 3.0);
+    EXPECT_EQ(p.Gamma_k_over_sigma0sq, 10.0);
     EXPECT_EQ(p.section, "hexagon");
     EXPECT_EQ(p.seed, 1);
     EXPECT_TRUE(p.rods_breakable);
@@ -96,10 +96,10 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{5, 15, 30}));
     EXPECT_EQ(p.sourceName, "case.toml");
     EXPECT_EQ(p.presetName, "");
-    // k = 1/10, sigma0 = delta0 k = 0.1 k, Gamma = 3 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
+    // k = 1/10, sigma0 = delta0 k = 0.1 k, Gamma = 10 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
     EXPECT_NEAR(p.k(), 0.1, kArithmeticTol * 0.1);
     EXPECT_NEAR(p.sigma0(), 1e-2, kArithmeticTol * 1e-2);
-    EXPECT_NEAR(p.Gamma(), 3e-3, kArithmeticTol * 3e-3);
+    EXPECT_NEAR(p.Gamma(), 1e-2, kArithmeticTol * 1e-2);
     EXPECT_NEAR(p.sigma_ru(), 21.4e-2, kArithmeticTol * 21.4e-2);
     EXPECT_NEAR(p.a0(), 16.0, kArithmeticTol * 16.0);
 }
@@ -257,7 +257,7 @@ TEST(CaseParams, BadSetOverride) {
 TEST(CaseParams, UnknownPreset) {
     const auto e = caseErrorOf([] { parse("", "fast"); });
     EXPECT_EQ(e.exitCode, exit_code::usage);
-    EXPECT_STREQ(e.what(), "unknown preset 'fast'; allowed presets: ci, reduced, paper");
+    EXPECT_STREQ(e.what(), "unknown preset 'fast'; allowed presets: ci, reduced, converged, paper");
 }
 
 TEST(CaseParams, LayeringDefaultsPresetFileSet) {
@@ -295,7 +295,7 @@ TEST(CaseParams, SetValuesAreTomlValues) {
 
 TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
     const auto names = enamel::presetNames();
-    ASSERT_EQ(names, (std::vector<std::string>{"ci", "reduced", "paper"}));
+    ASSERT_EQ(names, (std::vector<std::string>{"ci", "reduced", "converged", "paper"}));
     const CaseParams none = parse("");
     for (const std::string& name : names) {
         // A preset that set a physics key would throw std::logic_error here.
@@ -310,6 +310,13 @@ TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
     EXPECT_EQ(ci.v_app_over_cd, 2e-3);
     EXPECT_EQ(ci.stop_da_over_d, 5.0);
     EXPECT_EQ(ci.frames_da_over_d, (std::vector<double>{1, 2.5, 5}));
+    const CaseParams converged = parse("", "converged");   // the square size converged at the default G
+    EXPECT_EQ(converged.w_s_over_d, 80.0);
+    EXPECT_EQ(converged.h_s_over_d, 80.0);
+    EXPECT_EQ(converged.v_app_over_cd, 1e-3);
+    EXPECT_EQ(converged.integrator, "lumped");
+    EXPECT_EQ(converged.static_start, 0.95);
+    EXPECT_EQ(converged.stop_da_over_d, 30.0);
     const CaseParams paper = parse("", "paper");
     EXPECT_EQ(paper.w_s_over_d, 200.0);
     EXPECT_EQ(paper.h_s_over_d, 200.0);
@@ -504,11 +511,14 @@ TEST(CaseParams, SetValuesThatTomlCannotHoldAreRefusedOrEscaped) {
 // it is a cross-key check, still one line naming the key, the value and the allowed range.
 TEST(CaseParams, SofteningOverDelta0RangeDependsOnGamma) {
     EXPECT_EQ(parse("").softening_over_delta0, 1.0);
-    EXPECT_EQ(parse("softening_over_delta0 = 5\n").softening_over_delta0, 5.0);  // the triangle at G = 3
-    EXPECT_EQ(parse("softening_over_delta0 = 15\nGamma_k_over_sigma0sq = 8\n").softening_over_delta0, 15.0);
-    const auto high = caseErrorOf([] { parse("", "", {"softening_over_delta0=6"}); });
+    EXPECT_EQ(parse("softening_over_delta0 = 19\n").softening_over_delta0, 19.0);  // the triangle at G = 10
+    EXPECT_EQ(parse("softening_over_delta0 = 5\nGamma_k_over_sigma0sq = 3\n").softening_over_delta0, 5.0);
+    const auto high = caseErrorOf([] { parse("", "", {"softening_over_delta0=20"}); });
     EXPECT_EQ(high.exitCode, exit_code::out_of_range);
-    expectMessage(high, {"'softening_over_delta0'", "= 6", "(0, 5]", "Gamma_k_over_sigma0sq = 3"});
+    expectMessage(high, {"'softening_over_delta0'", "= 20", "(0, 19]", "Gamma_k_over_sigma0sq = 10"});
+    const auto highAt3 = caseErrorOf([] { parse("Gamma_k_over_sigma0sq = 3\n", "", {"softening_over_delta0=6"}); });
+    EXPECT_EQ(highAt3.exitCode, exit_code::out_of_range);
+    expectMessage(highAt3, {"'softening_over_delta0'", "= 6", "(0, 5]", "Gamma_k_over_sigma0sq = 3"});
     const auto zero = caseErrorOf([] { parse("softening_over_delta0 = 0\n"); });
     EXPECT_EQ(zero.exitCode, exit_code::out_of_range);
     expectMessage(zero, {"'softening_over_delta0'", "= 0", "(0, "});

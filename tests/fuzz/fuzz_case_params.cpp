@@ -2,7 +2,7 @@
 //
 // Input: the bytes are a case file (TOML text) for parseCase, with two kinds of directive lines
 // taken out of the text first (so that they can carry any bytes) and blanked (line numbers stay):
-//     #preset NAME       parse with that preset (ci | reduced | paper; anything else: unknown preset)
+//     #preset NAME       parse with that preset (ci | reduced | converged | paper; anything else: unknown preset)
 //     #set key=value     one --set override, in order
 // Without directive lines the whole input is the case file, with no preset and no --set.
 //
