@@ -14,7 +14,9 @@ from conftest import ROOT, run_with_kills
 from enamel_results.constants import KINETIC_WARN  # the solver's quasi-static warning bound
 
 CASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
-SETS = ["stop_da_over_d=2", "threads=1"]   # the ci preset stopped early: 0.6-1.5 s (10,409 steps)
+# at G = 3 (the default before 2026-12-04): at G = 10 this ci run's kinetic/strain ratio reaches 0.075 (measured
+# 2026-12-04) past the 0.05 bound, so the adaptive rate x8 is not quasi-static there; the rule is tested where it is
+SETS = ["stop_da_over_d=2", "threads=1", "Gamma_k_over_sigma0sq=3"]   # the ci preset stopped early: 0.6-1.5 s (10,409 steps)
 RHO_HIGH, RHO_LOW, RAISE = 0.01, 0.0025, 1.25   # loading_rate.hpp
 
 

