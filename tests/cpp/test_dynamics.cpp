@@ -58,7 +58,7 @@ void advanceTo(Simulation& sim, double t) {
 }  // namespace
 
 // A Gaussian pulse u = A exp(-(x - x0)^2 / 2 s^2) launched to the right (v = -c u'). Its centroid must move
-// at c_r = 1 within 1% (issue). The discrete dispersion of a linear element is about (k h_e)^2 / 24 ~ 1e-3
+// at c_r = 1 within 1% (the acceptance bound). The discrete dispersion of a linear element is about (k h_e)^2 / 24 ~ 1e-3
 // for s = 2 d, h_e = 0.3 d; the pulse stays 8 s away from the ends over the run.
 TEST(Dynamics, AxialWaveFrontTravelsAtRodWaveSpeed) {
   for (const char* integrator : {"paper", "lumped"}) {
@@ -79,7 +79,7 @@ TEST(Dynamics, AxialWaveFrontTravelsAtRodWaveSpeed) {
 // Undamped elastic specimen with interfaces (theta_D = 30, rods and interfaces unbreakable, zeta = 0) loaded by
 // the graded grip velocity: the external work must equal kinetic + strain energy of rods and interfaces. The
 // paper scheme's energy error (the trapezoid rule on the grip power, Newmark's O(dt^2) energy oscillation)
-// must stay below 1e-4 of the energy injected at every check (issue). The lumped scheme's balance lags by
+// must stay below 1e-4 of the energy injected at every check (the acceptance bound). The lumped scheme's balance lags by
 // one step (its kinetic energy uses v_{n+1/2} and its grip work is booked up to t_n, while q is at t_{n+1}):
 // the error is about dt P / W_ext, 5% in the first steps of the ramp where W_ext ~ t^5, 2.4e-3 at the end
 // of the ramp and 1.5e-3 at 3 T_r (measured); it is held to 4e-3 from the end of the ramp on (measured 2.8e-3).
@@ -109,7 +109,7 @@ TEST(Dynamics, UndampedElasticRunConservesEnergy) {
 // The first free-free axial mode u_x = A cos(pi x / L) released from rest under the run's own Rayleigh damping
 // (zeta = 0.2 at w_min = pi c_d / h_s, specimen chosen so that w_1 = pi / L is close to w_min): successive
 // extrema of the modal coordinate decay by exp(pi zeta / sqrt(1 - zeta^2)), which must give
-// zeta(w_1) = (a / w_1 + b w_1) / 2 within 5% (issue).
+// zeta(w_1) = (a / w_1 + b w_1) / 2 within 5% (the acceptance bound).
 TEST(Dynamics, SingleModeDampingRatioMatchesRayleigh) {
   Simulation sim(bundleCase("w_s_over_d = 12\nh_s_over_d = 4\nintegrator = \"paper\"\n"));
   double L = 0;

@@ -9,8 +9,8 @@ import pytest
 from conftest import PAPER_CASES
 
 R_THEORY = 4.0 / 3.0   # paper: corrugated crack faces, 4/3 of a flat crack's area per unit advance
-TOL_THEORY = 0.03      # issue: R_init and R_ss within 3% of 4/3
-TOL_RATE = 0.02        # issue: half the loading rate gives an R-curve within 2%
+TOL_THEORY = 0.03      # acceptance bound: R_init and R_ss within 3% of 4/3
+TOL_RATE = 0.02        # acceptance bound: half the loading rate gives an R-curve within 2%
 THETA0, THETA30 = "theta0_s21.4_e10_cv0", "theta30_s21.4_e10_cv0"
 
 
