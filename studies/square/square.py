@@ -359,7 +359,7 @@ def size_figure(recs: dict, G: float, out: pathlib.Path) -> bool:
     ax.set_xlabel(r"$\Delta a / d$")
     ax.set_ylabel(r"$R / \Gamma_i$")
     ax.set_ylim(bottom=0)
-    ax.set_title(f"theta30 (21.4, 10) at G = {G:g}, h_e = 0.3 d: square specimens of three sizes")
+    ax.set_title(f"theta30 (21.4, 10) at G = {G:g}, h_e = 0.3 d: square specimens of {len(shown)} sizes")
     ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
@@ -387,7 +387,7 @@ def report(data: pathlib.Path = DATA, readme: pathlib.Path = HERE / "README.md")
         figure(study, readme.parent / "rcurves.png")
         lines += ["![R-curves](rcurves.png)", ""]
     if G is not None and size_figure(study, G, readme.parent / "rcurves_sizes.png"):
-        lines += [f"At the selected G, the sizes side by side:", "", "![R-curves by size](rcurves_sizes.png)", ""]
+        lines += ["At the selected G, the sizes side by side:", "", "![R-curves by size](rcurves_sizes.png)", ""]
     text = readme.read_text()
     head = text.split("\n## Results\n", 1)[0]
     readme.write_text(head + "\n## Results\n" + "\n".join(lines))
