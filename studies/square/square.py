@@ -265,7 +265,32 @@ def validation(recs: dict, G: float) -> list[str]:
             f"{', '.join(f'{x:g}: {y:.3g}' for x, y in pts)} | {verdict} |"
             for t, series in summary_table.check_trends({n: Level(r) for n, r in at.items()}, trends)
             for label, pts, verdict in series if len(pts) >= 2]
-    return lines + (["", "| trend | series | points (x: y) | verdict |", "|---|---|---|---|"] + rows if rows else [])
+    return (lines + pooled_rm_lines(at, pv)
+            + (["", "| trend | series | points (x: y) | verdict |", "|---|---|---|---|"] + rows if rows else []))
+
+
+CV_SERIES = dict(theta_D=30.0, sigma_ru_over_sigma0=28.5, Er_over_kd=10.0)   # Figs. 8-9's series
+
+
+def pooled_rm_lines(at: dict, pv: dict) -> list[str]:
+    """Fig. 9's pooled R_m (metrics.pooled_rm: all R points with 0 < Delta_a/d < 30 of the realisations run) of
+    each cv group the paper states it for, from the largest-size records of the series' cases; one row per group,
+    with the realisations it pools (a group of fewer realisations than the paper's five says how many)."""
+    rows = []
+    for v in pv["value"]:
+        if v["quantity"] != "R_m_pooled_over_Gamma":
+            continue
+        group = [rec for case, rec in sorted(at.items())
+                 if (p := cases.params_from_name(case)) and all(p[k] == x for k, x in CV_SERIES.items())
+                 and any(math.isclose(p["cv"], c) for c in v["cv"])]
+        if not group:
+            continue
+        rm, _, _ = metrics.pooled_rm([metrics.RCurve.of(r["da"], r["R"]) for r in group])
+        cvs = ", ".join(f"{c:g}" for c in v["cv"])
+        rows.append(f"| {v['id']}: pooled R_m (cv {cvs}; {len(group)} realisation{'s' * (len(group) != 1)}) | "
+                    f"{paper_values.paper_value_text(v)} | {fmt(rm)} | {', '.join(r['name'] for r in group)} | "
+                    f"{value_verdict(v, rm)} |")
+    return rows
 
 
 def reading_of(rec: dict) -> str:

@@ -121,3 +121,22 @@ def test_a_reading_qualifies_only_with_a_late_first_break_and_the_level_kept(tmp
     (tmp_path / "two").mkdir()
     data2, readme2 = write(tmp_path / "two", base + [late_high, early, good])
     assert "**Qualifying so far: grip_constraint = uxuy.**" in square.report(data2, readme2)
+
+
+def test_pooled_rm_is_judged_per_cv_group_of_the_series(tmp_path):
+    n = square.run_name
+    converged = [record(n(80, 10), 80, 10, 6.6), record(n(100, 10), 100, 10, 6.8), record(n(40, 10), 40, 10, 6.5),
+                 record(n(40, 10, he=0.15), 40, 10, 6.9, he=0.15), record(n(80, 10, rate=0.5), 80, 10, 6.65, rate=0.5)]
+    val = []
+    for case, lvl in (("theta30_s28.5_e10_cv0", 12.0), ("theta30_s28.5_e10_cv0.3_seed1", 9.0),
+                      ("theta30_s21.4_e10_cv0.2_seed1", 1.0)):     # not the Figs. 8-9 series: not pooled
+        r = record(n(80, 10, case=case), 80, 10, lvl)
+        r["case"] = case
+        val.append(r)
+    data, readme = write(tmp_path, converged + val)
+    line = {l.split(":")[0].strip("| "): l for l in square.report(data, readme).splitlines() if l.startswith("| fig9")}
+    # the test curve's points over (0,30): level + 0.5 sin(da), the first point 5.0
+    low = np.r_[5.0, 12.0 + 0.5 * np.sin(DA[1:])][DA < 30].mean()
+    assert f"| {low:.3g} | theta30_s28.5_e10_cv0_s80_he0.3_G10 | reproduced" in line["fig9_R_m_low_cv"]
+    assert "(cv 0, 0.1; 1 realisation)" in line["fig9_R_m_low_cv"]
+    assert "theta30_s21.4" not in line["fig9_R_m_high_cv"] and "**not reproduced**" in line["fig9_R_m_high_cv"]
