@@ -4,10 +4,10 @@ the bench's error bound, its time and R-curve reported.
 
 The case is the bench's first (Fig. 4's theta_D = 30, sigma_ru/sigma0 = 21.4, Er/kd = 10) at the `paper`
 preset (200 d x 200 d, h_e = 0.3 d, 1.39 M DOF, v_app = 1e-3 c_d, stop at Delta_a = 30 d), integrator
-`lumped` with dt_factor 0.22 and damping_cap 0.5, at twice the preset's loading rate, started from the static
-elastic solution at 0.95 of the first-damage displacement (VARIANT below: the fastest loading that gives the same
-R-curve as the preset's rate at 100 x 100 d by `enamel_results.metrics.same_rcurve`; the adaptive loading rate,
-rate_adapt_max 4, does not: R mean -3.4%), on 2 threads. It takes hours, so it is resumable: Ctrl-C (or SIGTERM) writes a
+`lumped` with dt_factor 0.22 and damping_cap 0.5, started from the static
+elastic solution at 0.95 of the first-damage displacement, at the preset's loading rate (VARIANT below: twice
+the rate gave the same R-curve at 100 x 100 d by `enamel_results.metrics.same_rcurve`, but not at this size), on 2
+threads. It takes hours, so it is resumable: Ctrl-C (or SIGTERM) writes a
 checkpoint and stops; the same command again continues from it (the result is the same, bit for bit at the
 same thread count). A checkpoint is also written every --checkpoint-every seconds.
 
@@ -35,12 +35,12 @@ from enamel_results import paper_values, paths, results  # noqa: E402
 from figures import plotting  # noqa: E402
 
 CASE = run_bench.CASES[0]
-# The fastest loading within the bound at 100 x 100 d (bench/experiments/check_100 records judged by
-# metrics.same_rcurve in studies/square/rejudged.md): twice the preset's rate, from the static start; against its
-# half-rate twin (the static start at the preset's rate) R averaged over (0,30] d +0.7%, R_init +1.1%, 25 / 25
-# broken rods (the pointwise L2, 5.3%, is reported, not deciding). Both warn KE/SE > 0.05 at that size, as does
-# the run from rest at the preset's rate (0.155): the bursts after rod breaks.
-VARIANT = "lumped cap0.5 dt0.22 static rate2"
+# The preset's loading rate, from the static start. Twice the rate was the fastest loading within the bound at
+# 100 x 100 d and G = 3 (bench/experiments/check_100 judged by metrics.same_rcurve in studies/square/rejudged.md:
+# R averaged over (0,30] d +0.7%), but at the paper's size and G = 10 it is not: against this variant R over
+# (0,30] d -11.6%, R_init +0.9%, 30 / 31 rods (studies/square/README.md, "reported: faster loading x2"; records
+# s200_he0.3_G10 and s200_he0.3_G10_rate2, 2026-12-04, AMD EPYC). It takes about twice the steps (345 k).
+VARIANT = "lumped cap0.5 dt0.22 static"
 PRESET = "paper"
 EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests)
 RUNS = paths.BENCH_PAPER_PRESET    # --runs

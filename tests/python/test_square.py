@@ -52,6 +52,20 @@ def test_nothing_is_selected_without_a_converged_G(tmp_path):
     assert "**Selected: none yet**" in square.report(data, readme)
 
 
+def test_a_faster_loading_is_reported_and_a_slow_twin_decides(tmp_path):
+    n = square.run_name
+    base = [record(n(80, 10), 80, 10, 6.6), record(n(100, 10), 100, 10, 6.7),
+            record(n(40, 10), 40, 10, 6.5), record(n(40, 10, he=0.15), 40, 10, 6.9, he=0.15),
+            record(n(100, 10, rate=2), 100, 10, 5.5, rate=2)]                    # x2 differs by 18%: reported
+    (tmp_path / "a").mkdir()
+    data, readme = write(tmp_path / "a", base + [record(n(40, 10, rate=0.5), 40, 10, 6.52, rate=0.5)])
+    text = square.report(data, readme)
+    assert "| reported: faster loading x2 |" in text and "**Selected by the records so far: G = 10**" in text
+    (tmp_path / "b").mkdir()
+    data, readme = write(tmp_path / "b", base + [record(n(40, 10, rate=0.5), 40, 10, 6.0, rate=0.5)])
+    assert "**Selected: none yet**" in square.report(data, readme)                 # the half-rate twin differs
+
+
 def test_run_arguments_are_the_plans():
     args = square.solver_args("enamel-dem", 100, 10, 0.3, 1.0, "out")
     sets = {args[i + 1].split("=")[0]: args[i + 1].split("=", 1)[1] for i, a in enumerate(args) if a == "--set"}
