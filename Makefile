@@ -23,9 +23,9 @@
 #                       2 cores): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
-#   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d with the fastest scheme
-#                       within the bench's error bound (~10 h on 2 cores; Ctrl-C writes a checkpoint, the same
-#                       command continues): bench/paper_preset.md, bench/out/paper_preset.png
+#   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate
+#                       from the static start (1.3 h on 2 cores of an AMD EPYC, 2026-12-04; Ctrl-C writes a
+#                       checkpoint, the same command continues): bench/paper_preset.md, bench/out/paper_preset.png
 #   make bench-far-field  the reduced far field against the full model at 80 x 80 d (docs/solver.md; 8 runs, ~3 h on 2
 #                       cores, resumable; FF_RUNS="cv03_full cv03_m2_h22" for some): studies/far_field/record_*.json
 #   make identify       [IDENTIFY_ARGS=...]  the interface-ductility identification: niced resumable runs in
