@@ -232,6 +232,16 @@ def ours(rec: dict, quantity: str) -> float:
     return first_break(rec) if rec.get("rod_da") else math.inf   # no rod broke: none before any advance
 
 
+ZONE_WARNING = "inelastic zone reached"   # the solver's warning when the zone comes within 2 d of the loaded edges
+
+
+def zone_note(recs: list[dict]) -> str:
+    """' (...)' naming the runs whose inelastic zone reached the loaded edges (their R may depend on the size),
+    or ''."""
+    hit = [r["name"] for r in recs if ZONE_WARNING in r.get("warnings", "")]
+    return f" (inelastic zone at the loaded edges in {', '.join(hit)}: not size-converged)" if hit else ""
+
+
 def value_verdict(v: dict, x: float) -> str:
     if v["relation"] == ">=":
         return "reproduced" if x >= v["value"] else "**not reproduced**"
@@ -263,7 +273,7 @@ def validation(recs: dict, G: float) -> list[str]:
             fitted = " (the selection's own quantity: not a validation)" if (
                 v["case"] == CASE and v["quantity"] == "R_ss_over_Gamma") else ""
             lines.append(f"| {v['id']}: {OURS[v['quantity']]} | {paper_values.paper_value_text(v)} | "
-                         f"{fmt(ours(rec, v['quantity']))} | {rec['name']} | {value_verdict(v, ours(rec, v['quantity']))}{fitted} |")
+                         f"{fmt(ours(rec, v['quantity']))} | {rec['name']} | {value_verdict(v, ours(rec, v['quantity']))}{fitted}{zone_note([rec])} |")
     trends = {"trend": [t for t in pv["trend"] if t["quantity"] in ("R_init_over_Gamma", "R_ss_over_Gamma")]}
     rows = [f"| {t['id']} ({t['quantity']} against {t['against']}) | {label} | "
             f"{', '.join(f'{x:g}: {y:.3g}' for x, y in pts)} | {verdict} |"
@@ -293,7 +303,7 @@ def pooled_rm_lines(at: dict, pv: dict) -> list[str]:
         cvs = ", ".join(f"{c:g}" for c in v["cv"])
         rows.append(f"| {v['id']}: pooled R_m (cv {cvs}; {len(group)} realisation{'s' * (len(group) != 1)}) | "
                     f"{paper_values.paper_value_text(v)} | {fmt(rm)} | {', '.join(r['name'] for r in group)} | "
-                    f"{value_verdict(v, rm)} |")
+                    f"{value_verdict(v, rm)}{zone_note(group)} |")
     return rows
 
 

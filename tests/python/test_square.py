@@ -154,3 +154,11 @@ def test_pooled_rm_is_judged_per_cv_group_of_the_series(tmp_path):
     assert f"| {low:.3g} | theta30_s28.5_e10_cv0_s80_he0.3_G10 | reproduced" in line["fig9_R_m_low_cv"]
     assert "(cv 0, 0.1; 1 realisation)" in line["fig9_R_m_low_cv"]
     assert "theta30_s21.4" not in line["fig9_R_m_high_cv"] and "**not reproduced**" in line["fig9_R_m_high_cv"]
+    assert "inelastic zone" not in line["fig9_R_m_low_cv"]
+    val[0]["warnings"] = "inelastic zone reached 38.2 d from the crack plane at step 1, within 2 d of the loaded edges\n"
+    (tmp_path / "zone").mkdir()
+    data, readme = write(tmp_path / "zone", converged + val)
+    line = {l.split(":")[0].strip("| "): l for l in square.report(data, readme).splitlines() if l.startswith("| fig9")}
+    assert line["fig9_R_m_low_cv"].endswith(
+        "(inelastic zone at the loaded edges in theta30_s28.5_e10_cv0_s80_he0.3_G10: not size-converged) |")
+    assert "inelastic zone" not in line["fig9_R_m_high_cv"]
