@@ -1,15 +1,15 @@
 #!/usr/bin/env python3
 """`make bench-paper`: one `paper`-preset case run to Delta_a/d = 30 with the fastest scheme that stays within
-the bench's error bound, its time and R-curve reported.
+the bench's error bound at this size, its time and R-curve reported.
 
 The case is the bench's first (Fig. 4's theta_D = 30, sigma_ru/sigma0 = 21.4, Er/kd = 10) at the `paper`
 preset (200 d x 200 d, h_e = 0.3 d, 1.39 M DOF, v_app = 1e-3 c_d, stop at Delta_a = 30 d), integrator
-`lumped` with dt_factor 0.22 and damping_cap 0.5, started from the static
-elastic solution at 0.95 of the first-damage displacement, at the preset's loading rate (VARIANT below: twice
-the rate gave the same R-curve at 100 x 100 d by `enamel_results.metrics.same_rcurve`, but not at this size), on 2
-threads. It takes hours, so it is resumable: Ctrl-C (or SIGTERM) writes a
-checkpoint and stops; the same command again continues from it (the result is the same, bit for bit at the
-same thread count). A checkpoint is also written every --checkpoint-every seconds.
+`lumped` with dt_factor 0.22 and damping_cap 0.5, started from the static elastic solution at 0.95 of the
+first-damage displacement, at the preset's loading rate (VARIANT below: twice the rate gave the same R-curve at
+100 x 100 d by `enamel_results.metrics.same_rcurve`, but not at this size), on 2 threads. It takes hours, so it
+is resumable: Ctrl-C (or SIGTERM) writes a checkpoint and stops; the same command again continues from it (the
+result is the same, bit for bit at the same thread count). A checkpoint is also written every
+--checkpoint-every seconds.
 
 Then it writes bench/paper_preset.md (committed: the README quotes it) and bench/out/paper_preset.{pdf,png}:
 the R-curve against the same case at the `reduced` size (the `paper` scheme and the same fast scheme, from

@@ -239,7 +239,7 @@ def zone_note(recs: list[dict]) -> str:
     """' (...)' naming the runs whose inelastic zone reached the loaded edges (their R may depend on the size),
     or ''."""
     hit = [r["name"] for r in recs if ZONE_WARNING in r.get("warnings", "")]
-    return f" (inelastic zone at the loaded edges in {', '.join(hit)}: not size-converged)" if hit else ""
+    return f" (inelastic zone at the loaded edges in {', '.join(hit)}: R may depend on the size)" if hit else ""
 
 
 def value_verdict(v: dict, x: float) -> str:
