@@ -41,7 +41,8 @@ EVENTS = ("Ir", "D1mr", "D1mw", "DLmr", "DLmw")   # instructions; first-level an
 KERNELS = {
     "step": (("enamel::Simulation::step()",), "DOF"),
     "advance": (("LumpedIntegrator::advance(",), "DOF"),
-    "interfaces": (("enamel::computeForcesForInterfacesScheduled(", "enamel::computeForcesForInterfaces("), "interfaces"),
+    "interfaces": (("enamel::computeInterfaceCorrectionsScheduled(", "enamel::computeForcesForInterfacesScheduled(",
+                    "enamel::computeForcesForInterfaces("), "interfaces"),
     "positions": (("enamel::advancePositions(",), "DOF"),
 }
 
@@ -83,7 +84,7 @@ def _counts(line: str) -> list[int]:
 def inclusive_per_call(out: pathlib.Path) -> dict:
     """{kernel: {event: inclusive count per call}} from callgrind_annotate's caller tree: the line marked '*' of
     the function carries its inclusive counts, the lines above it ('<') its callers with their call counts."""
-    text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=caller", f"--show={','.join(EVENTS)}",
+    text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=caller", "--threshold=100", f"--show={','.join(EVENTS)}",
                            str(out)], capture_output=True, text=True, check=True).stdout
     blocks = text.split("\n\n")
     got = {}

@@ -274,11 +274,13 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 //   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
 //   2 / omega_max (sqrt(1 + xi^2) - xi), xi = b' omega_max / 2.
 // One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first:
-//   f_iface(q_n), K q_n, K v_{n-1/2}                      (forces for interfaces, for beams; the interfaces'
-//                                                          history is updated here, at q_n; an elastic
-//                                                          interface's force is linear, and the law sees
-//                                                          only those that could leave the elastic track:
-//                                                          InterfaceSchedule, kernels.hpp)
+//   f_iface(q_n) = K_I q_n + f_corr, K q_n, K v_{n-1/2}  (forces for interfaces, for beams: every interface's
+//                                                          elastic force is linear, K_I q_n (K_I: the elastic
+//                                                          interfaces' stiffness, elasticInterfaceBlocks); the
+//                                                          law sees only those that could leave the elastic
+//                                                          track (InterfaceSchedule, kernels.hpp), and f_corr is
+//                                                          the law's force minus the elastic one of those off
+//                                                          it; the interfaces' history is updated here, at q_n)
 //   v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} + dt M^-1 (-K q_n - f_iface - b' K v_{n-1/2})] / (1 + a dt/2)
 //   v_{n+1/2} of the grips = shape V(t_n + dt/2)          (velocities, boundary condition on them)
 //   R_p = (K q + f_iface + b' K v_{n-1/2} + M (a_p + a v_p))_p at t_n, with the grips' a_p and v_p by central
@@ -294,6 +296,7 @@ class LumpedIntegrator : public Integrator {
     const double L = m.beamLength;
     rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
     Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
+    KI_ = elasticInterfaceBlocks(m, mat.law, ops);
     // per element end, of an element spanning `span` slices (1 but in a reduced far field)
     auto mt = [&](int span) { return 0.5 * mat.section.rho * mat.section.A * (span * L); };
     auto jr = [&](int span) { return rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * (span * L); };
@@ -340,7 +343,8 @@ class LumpedIntegrator : public Integrator {
     std::ostringstream o;
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
       << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36
-      << " distinct 6x6 stiffness blocks" << (Kblocks_.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)");
+      << " distinct 6x6 stiffness blocks" << (Kblocks_.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)")
+      << ", elastic interfaces in " << KI_.values.size() / 36 << " distinct 6x6 blocks (18 entries each)";
     return o.str();
   }
 
@@ -391,10 +395,10 @@ class LumpedIntegrator : public Integrator {
 
   // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a
   // slice in a fixed order, so nothing depends on the thread count). Per slice:
-  //   the wrench of its interfaces on its nodes: the elastic force of those the law need not see
-  //     (InterfaceSchedule, kernels.hpp), the law's (opening, law, force on B) of the others, their history
-  //     updated at q_n
-  //   per node (advanceVelocityOfNode): K q_n and K v_{n-1/2} (its block row), r = K q + f_iface + b' K v,
+  //   the wrench W of its interfaces on its nodes beyond their elastic force: the law's (opening, law, force
+  //     on B) of those the schedule makes due (InterfaceSchedule, kernels.hpp), their history updated at q_n,
+  //     less the elastic force of those off the elastic branch
+  //   per node (advanceNode): K q_n, K_I q_n and K v_{n-1/2} (its block rows), r = K q + K_I q - W + b' K v,
   //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
   //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
   //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
@@ -423,7 +427,7 @@ class LumpedIntegrator : public Integrator {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
       for (int k = 0; k < m.numSlices; ++k) {
-        failed += addInterfaceWrenchesOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
+        failed += addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
         SliceSums sums;
         const int firstNode = ops.sliceNodeStart[k];
         for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
@@ -441,8 +445,9 @@ class LumpedIntegrator : public Integrator {
     DoublePair largestStep = {0, 0}, largestValue = {0, 0};
   };
 
-  // One node's v_{n+1/2} into vNext_ from its block row of K times q and v (= v_{n-1/2}) and the wrench of its
-  // interfaces W (f_iface = -W, so r = K q - W + b' K v), and its q_{n+1} = q_n + dt v_{n+1/2} into qNext_
+  // One node's v_{n+1/2} into vNext_ from its block rows of K times q and v (= v_{n-1/2}) and of K_I times q, and
+  // the wrench of its interfaces beyond their elastic force W (f_iface = K_I q - W, so r = K q + K_I q - W + b' K v),
+  // and its q_{n+1} = q_n + dt v_{n+1/2} into qNext_
   // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv over its DOFs in order, max |dt v| and
   // max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
   [[gnu::always_inline]] inline void advanceNode(const Operators& ops, const NodeStep& c, int node, const double* q,
@@ -457,12 +462,14 @@ class LumpedIntegrator : public Integrator {
       multiplyBlockRow(K, node, q, v, a, b);
       for (int j = 0; j < 3; ++j) Kq[j] = Pair{a[2 * j], a[2 * j + 1]}, Kv[j] = Pair{b[2 * j], b[2 * j + 1]};
     }
+    Pair KIq[3];
+    multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq);
     auto pairs = [node](const double* x) { return static_cast<const Pair*>(__builtin_assume_aligned(x + 6 * node, 16)); };
     const Pair *vNode = pairs(v), *invM = pairs(invMass_.data()), *mass = pairs(mass_.data());
     const Pair* Wp = static_cast<const Pair*>(__builtin_assume_aligned(W, 16));
     Pair r[3], vn[3];
     for (int j = 0; j < 3; ++j) {
-      r[j] = (Kq[j] - Wp[j]) + Pair{c.b, c.b} * Kv[j];
+      r[j] = ((Kq[j] + KIq[j]) - Wp[j]) + Pair{c.b, c.b} * Kv[j];
       vn[j] = (Pair{c.keep, c.keep} * vNode[j] - Pair{c.dt, c.dt} * (invM[j] * r[j])) / Pair{c.scale, c.scale};
     }
     if (nodeHasGrip_[node])
@@ -542,6 +549,7 @@ class LumpedIntegrator : public Integrator {
   std::vector<std::uint8_t> nodeHasGrip_;      // per node: 1 when one of its DOFs is prescribed
   std::vector<SliceSums> sliceSums_;  // per slice
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
+  NodeBlockMatrix KI_;       // the elastic interfaces' stiffness K_I in node blocks (kernels.hpp)
 };
 
 }  // namespace

@@ -2,9 +2,11 @@
 #include "node_blocks.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
+#include "errors.hpp"
 #include "loading_rate.hpp"
 
 namespace enamel {
@@ -131,11 +133,12 @@ double separationRate(const cohesive::Law& law, const cohesive::SliceInterface& 
 
 double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElasticTrack) * law.delta0(); }
 
-// A due interface: the law at its opening (history updated), the force it exerts (elastic while the secant
-// stiffness is k) and the drift from which it is due again.
-[[gnu::noinline]] cohesive::Vec3 evaluateDueInterface(const cohesive::Law& law, const cohesive::SliceInterface& g,
-                                                     const double* qA, const double* qB, double drift,
-                                                     double& lambdaMax, double& due, int& failed) {
+// A due interface: the law at its opening (history updated) and the drift from which it is due again. Off the
+// elastic branch it is due at every step, and `correction` is its force beyond the elastic one (the law's minus
+// elasticForceOnB): returns true; on the elastic branch its force is the elastic one: returns false.
+[[gnu::noinline]] bool evaluateDueInterface(const cohesive::Law& law, const cohesive::SliceInterface& g,
+                                            const double* qA, const double* qB, double drift, double& lambdaMax,
+                                            double& due, int& failed, cohesive::Vec3& correction) {
   using Map3 = Eigen::Map<const cohesive::Vec3>;
   const Map3 uA(qA), thA(qA + 3), uB(qB), thB(qB + 3);
   const cohesive::Vec3 opening = cohesive::localOpening(g, cohesive::computeOpening(g, uA, thA, uB, thB));
@@ -143,11 +146,12 @@ double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElast
   failed += cohesive::isFailed(law, lambdaMax);
   if (cohesive::secantStiffness(law, lambdaMax) != law.k) {
     due = drift;  // off the elastic branch: the law at every step
-    return cohesive::forceOnBOfTraction(g, t);
+    correction = cohesive::forceOnBOfTraction(g, t) - cohesive::elasticForceOnB(law, g, uA, thA, uB, thB);
+    return true;
   }
   const double room = (1.0 - kInterfaceScheduleMargin) * lambdaTrack(law) - cohesive::effectiveSeparation(law, opening);
   due = room > 0 ? drift + room / separationRate(law, g) : drift;  // (a NaN opening: due again)
-  return cohesive::elasticForceOnB(law, g, uA, thA, uB, thB);
+  return false;
 }
 }  // namespace
 
@@ -166,10 +170,42 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
   schedule.dueBelow = small ? schedule.drift : INFINITY;
 }
 
-[[gnu::flatten]] int addInterfaceWrenchesOfSliceScheduled(const Model& m, const cohesive::Law& lawGiven,
-                                                          const Operators& ops, int k, const double* q,
-                                                          double* lambdaMax, InterfaceSchedule& schedule,
-                                                          double* wrench, long& evaluated) {
+NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law, const Operators& ops) {
+  using Block = std::array<double, 36>;
+  auto blockOf = [](const Eigen::Matrix<double, 12, 12>& K, int sideRow, int sideColumn) {
+    Block b;
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 6; ++i) b[6 * j + i] = K(6 * sideRow + i, 6 * sideColumn + j);
+    return b;
+  };
+  auto addTo = [](Block& sum, const Block& b) {
+    for (int e = 0; e < 36; ++e) sum[e] += b[e];
+  };
+  auto row = [&](int R, BlockRow& blocks) {
+    Block diagonal{};
+    for (int e = ops.nodeIfaceStart[R]; e < ops.nodeIfaceStart[R + 1]; ++e) {  // ascending interface order
+      const int i = ops.nodeIfaceList[e] / 2, side = ops.nodeIfaceList[e] % 2;
+      const Eigen::Matrix<double, 12, 12> K = cohesive::elasticStiffness(law, m.ifaceGeom[i]);
+      addTo(diagonal, blockOf(K, side, side));
+      const int other = m.ifaceNodes[i][1 - side];
+      auto at = std::find_if(blocks.begin(), blocks.end(), [&](const auto& b) { return b.first == other; });
+      if (at == blocks.end()) blocks.push_back({other, Block{}}), at = blocks.end() - 1;
+      addTo(at->second, blockOf(K, side, 1 - side));
+    }
+    if (ops.nodeIfaceStart[R] == ops.nodeIfaceStart[R + 1]) return;  // no interface: an empty row
+    blocks.push_back({R, diagonal});
+    std::stable_sort(blocks.begin(), blocks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  };
+  NodeBlockMatrix K = toNodeBlocks(m.numNodes(), row, kInterfaceGroups, kInterfaceBlockTolerance);
+  if (K.split.empty() && !K.values.empty())
+    throw SolverError("interface stiffness: couples (ux, ry, rz) with (uy, uz, rx): an interface not in its slice");
+  return K;
+}
+
+[[gnu::flatten]] int addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& lawGiven,
+                                                             const Operators& ops, int k, const double* q,
+                                                             double* lambdaMax, InterfaceSchedule& schedule,
+                                                             double* wrench, long& evaluated) {
   const cohesive::Law law = lawGiven;  // a local copy, as in addInterfaceWrenchesOfSlice
   int failed = 0;
   const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1], firstNode = ops.sliceNodeStart[k];
@@ -178,27 +214,22 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
   const cohesive::SliceInterface* packed = ops.ifacePacked.data();
   double* due = schedule.due.data();
   const double drift = schedule.drift, dueBelow = schedule.dueBelow;
-  using Map3 = Eigen::Map<const cohesive::Vec3>;
   for (int i = first; i < last; ++i) {
+    if (due[i] > dueBelow) continue;  // elastic, and its force is in K_I q
     const int A = nodes[i][0], B = nodes[i][1];
-    const double *qA = q + 6 * A, *qB = q + 6 * B;
-    cohesive::Vec3 F;
-    if (due[i] <= dueBelow) {
-      F = evaluateDueInterface(law, packed[i], qA, qB, drift, lambdaMax[i], due[i], failed);
-      ++evaluated;
-    } else {
-      F = cohesive::elasticForceOnB(law, packed[i], Map3(qA), Map3(qA + 3), Map3(qB), Map3(qB + 3));
-    }
-    addWrenchesOfForce(packed[i], F, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+    cohesive::Vec3 correction;
+    ++evaluated;
+    if (evaluateDueInterface(law, packed[i], q + 6 * A, q + 6 * B, drift, lambdaMax[i], due[i], failed, correction))
+      addWrenchesOfForce(packed[i], correction, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
   }
   return failed;
 }
 
 // Not inlined: the profile's "interfaces" kernel, which bench/step_instructions.py finds by its name.
-[[gnu::noinline]] int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law,
-                                                          const Operators& ops, const VecX& q,
-                                                          std::vector<double>& lambdaMax,
-                                                          InterfaceSchedule& schedule, VecX& f) {
+[[gnu::noinline]] int computeInterfaceCorrectionsScheduled(const Model& m, const cohesive::Law& law,
+                                                           const Operators& ops, const VecX& q,
+                                                           std::vector<double>& lambdaMax,
+                                                           InterfaceSchedule& schedule, VecX& f) {
   f.resize(m.numDofs());
   int failed = 0;
   long evaluated = 0;
@@ -207,13 +238,25 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
     std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
     for (int k = 0; k < m.numSlices; ++k) {
-      failed += addInterfaceWrenchesOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(), schedule,
-                                                     wrench.data(), evaluated);
+      failed += addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(), schedule,
+                                                        wrench.data(), evaluated);
       const int firstNode = ops.sliceNodeStart[k];
       for (int dof = 6 * firstNode; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) f[dof] = -wrench[dof - 6 * firstNode];
     }
   }
   schedule.evaluated = evaluated;
+  return failed;
+}
+
+int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
+                                        const NodeBlockMatrix& elasticBlocks, const VecX& q,
+                                        std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f) {
+  const int failed = computeInterfaceCorrectionsScheduled(m, law, ops, q, lambdaMax, schedule, f);
+  Vec6 elastic;
+  for (int R = 0; R < m.numNodes(); ++R) {
+    multiplyBlockRowSplit<kInterfaceGroups>(elasticBlocks, R, q.data(), elastic);
+    f.segment<6>(6 * R) = elastic + f.segment<6>(6 * R);
+  }
   return failed;
 }
 

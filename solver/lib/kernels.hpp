@@ -3,6 +3,7 @@
 // (state.hpp). No I/O. The time integrators (integrators.hpp) and the simulation (simulation.hpp) call them.
 #include <vector>
 
+#include "node_blocks.hpp"
 #include "state.hpp"
 
 namespace enamel {
@@ -67,18 +68,33 @@ struct InterfaceSchedule {
 /// opening, 32 eps c |q|_inf, could reach a quarter of the margin, kInterfaceScheduleMargin lambdaTrack / 4.
 void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Operators& ops, double moved,
                               double largestValue, InterfaceSchedule& schedule);
-/// addInterfaceWrenchesOfSlice with the schedule (the lumped step's pass, lambdaMax always updated): an
-/// interface not due exerts cohesive::elasticForceOnB; a due one is evaluated by the law (history updated), and
-/// exerts elasticForceOnB while elastic, the law's force otherwise, and gets its next due drift. Adds the
+/// The interfaces' elastic stiffness K_I in node blocks (groups kInterfaceGroups): the sum over interfaces of
+/// cohesive::elasticStiffness, so that K_I q is every interface's elastic force (f_iface of interfaces on the
+/// elastic branch: cohesive::elasticForceOnB, up to round-off). Block row R: its diagonal block (the interfaces
+/// of node R, summed in ascending interface order from +0) and one block per node it shares an interface with
+/// (ascending columns). Each distinct block is stored once: the geometry repeats from slice to slice.
+inline constexpr double kInterfaceBlockTolerance = 0x1p-40;  // ~9.1e-13
+NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law, const Operators& ops);
+
+/// The lumped step's interface pass with the schedule, for a step that applies every interface's elastic force
+/// as K_I q (elasticInterfaceBlocks) in its node rows: into wrench, per node of slice k, what the law adds to
+/// that, the wrench of (law's force - elastic force) of each interface off the elastic branch. An interface
+/// not due adds nothing (it is elastic); a due one is evaluated by the law (lambdaMax updated), adds its
+/// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. Adds the
 /// interfaces evaluated to `evaluated`; returns the number of failed interfaces of the slice.
-int addInterfaceWrenchesOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
-                                         const double* q, double* lambdaMax, InterfaceSchedule& schedule,
-                                         double* wrench, long& evaluated);
-/// f_iface by addInterfaceWrenchesOfSliceScheduled over all slices (the profile and the tests; the lumped step
-/// runs the slice pass inside its own). Returns the number of failed interfaces.
+int addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
+                                            const double* q, double* lambdaMax, InterfaceSchedule& schedule,
+                                            double* wrench, long& evaluated);
+/// f_corr = -(the wrench of addInterfaceCorrectionsOfSliceScheduled) over all slices: the profile's
+/// "interfaces" kernel, the interface pass as the lumped step runs it. Returns the number of failed interfaces.
+int computeInterfaceCorrectionsScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
+                                         const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule,
+                                         VecX& f);
+/// f_iface = K_I q + f_corr (the lumped step's interface forces, as one vector: the tests). Returns the number
+/// of failed interfaces.
 int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
-                                        const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule,
-                                        VecX& f);
+                                        const NodeBlockMatrix& elasticBlocks, const VecX& q,
+                                        std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f);
 /// What a position update moved: the largest |dt v_i| added and the largest |q_i| after it.
 struct PositionMove {
   double largestStep = 0, largestValue = 0;

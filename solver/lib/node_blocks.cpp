@@ -1,6 +1,8 @@
 #include "node_blocks.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <unordered_map>
 
@@ -8,30 +10,63 @@
 
 namespace enamel {
 
-// split's layout: for k = 0, 1, 2 with column i = kInPlaneDofs[k] and column o = kOutOfPlaneDofs[k], the pairs
-// (B(0, i), B(1, i)), (B(2, o), B(3, o)), (B(4, o), B(5, i)): rows 0-1 and 5 take the in-plane columns, rows
-// 2-4 the out-of-plane ones, each in ascending column order. Empty when some block couples the groups.
-std::vector<DoublePair> splitBlocks(const std::vector<double>& values) {
+// split's layout: for k = 0, 1, 2 and the row pairs p = (0, 1), (2, 3), (4, 5), the pair (B(r0, c0), B(r1, c1))
+// with c = groups.column(r, k): each row takes its own group's columns in ascending order. Empty when some block
+// couples the groups.
+std::vector<DoublePair> splitBlocks(const std::vector<double>& values, const DofGroups& groups) {
   std::vector<DoublePair> split;
   for (std::size_t v = 0; 36 * v < values.size(); ++v) {
     auto B = [&](int i, int j) { return values[36 * v + 6 * j + i]; };
-    for (int i : kInPlaneDofs)
-      for (int j : kOutOfPlaneDofs)
+    for (int i : groups.first)
+      for (int j : groups.second)
         if (B(i, j) != 0.0 || B(j, i) != 0.0) return {};
-    for (int k = 0; k < 3; ++k) {
-      const int i = kInPlaneDofs[k], o = kOutOfPlaneDofs[k];
-      split.insert(split.end(), {DoublePair{B(0, i), B(1, i)}, DoublePair{B(2, o), B(3, o)}, DoublePair{B(4, o), B(5, i)}});
-    }
+    for (int k = 0; k < 3; ++k)
+      for (int r = 0; r < 6; r += 2)
+        split.push_back(DoublePair{B(r, groups.column(r, k)), B(r + 1, groups.column(r + 1, k))});
   }
   return split;
 }
 
-NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
+namespace {
+// Distinct blocks, kept once each: a block's 36 values -> its index in B.values. Exact (tolerance 0: bit for bit),
+// or with a relative tolerance t: the values rounded to a multiple of t times the power of two at or above the
+// block's largest |entry| (and that power) are the key, and the first block of a key stands for all of them.
+struct DistinctBlocks {
+  double tolerance = 0;
+  std::unordered_map<std::string, int> index;
+  std::string keyOf(const std::array<double, 36>& block) const {
+    if (tolerance == 0) return std::string(reinterpret_cast<const char*>(block.data()), sizeof block);
+    double largest = 0;
+    for (double v : block) largest = std::max(largest, std::abs(v));
+    int exponent = 0;
+    std::frexp(largest, &exponent);
+    const double quantum = tolerance * std::ldexp(1.0, exponent);
+    std::array<long long, 37> key;
+    key[36] = exponent;
+    for (int e = 0; e < 36; ++e) key[e] = largest > 0 ? std::llround(block[e] / quantum) : 0;
+    return std::string(reinterpret_cast<const char*>(key.data()), sizeof key);
+  }
+  void add(NodeBlockMatrix& B, int column, const std::array<double, 36>& block) {
+    const auto [it, added] = index.emplace(keyOf(block), static_cast<int>(index.size()));
+    if (added) B.values.insert(B.values.end(), block.begin(), block.end());
+    B.column.push_back(column);
+    B.valueOf.push_back(it->second);
+  }
+};
+
+void finishSplit(NodeBlockMatrix& B, const DofGroups& groups) {
+  B.split = splitBlocks(B.values, groups);
+  if (!B.split.empty())
+    for (int v : B.valueOf) B.splitAt.push_back(9 * v);
+}
+}  // namespace
+
+NodeBlockMatrix toNodeBlocks(const SpMatRow& K, const DofGroups& groups) {
   if (K.rows() % 6 != 0) throw SolverError("stiffness matrix: size not a multiple of 6");
   NodeBlockMatrix B;
   B.blockRows = static_cast<int>(K.rows() / 6);
   B.start.assign(1, 0);
-  std::unordered_map<std::string, int> distinct;  // a block's 36 values, bit for bit -> its index
+  DistinctBlocks distinct;
   std::array<double, 36> block;
   for (int R = 0; R < B.blockRows; ++R) {
     const int first = static_cast<int>(K.outerIndexPtr()[6 * R]), count = K.outerIndexPtr()[6 * R + 1] - first;
@@ -46,17 +81,31 @@ NodeBlockMatrix toNodeBlocks(const SpMatRow& K) {
             throw SolverError("stiffness matrix: the rows of a node do not share one block pattern");
           block[6 * j + i] = K.valuePtr()[at];
         }
-      const std::string key(reinterpret_cast<const char*>(block.data()), sizeof block);
-      const auto [it, added] = distinct.emplace(key, static_cast<int>(distinct.size()));
-      if (added) B.values.insert(B.values.end(), block.begin(), block.end());
-      B.column.push_back(c / 6);
-      B.valueOf.push_back(it->second);
+      distinct.add(B, c / 6, block);
     }
     B.start.push_back(static_cast<int>(B.column.size()));
   }
-  B.split = splitBlocks(B.values);
-  if (!B.split.empty())
-    for (int v : B.valueOf) B.splitAt.push_back(9 * v);
+  finishSplit(B, groups);
+  return B;
+}
+
+NodeBlockMatrix toNodeBlocks(int blockRows, const std::function<void(int, BlockRow&)>& rows, const DofGroups& groups,
+                             double tolerance) {
+  NodeBlockMatrix B;
+  B.blockRows = blockRows;
+  B.start.assign(1, 0);
+  DistinctBlocks distinct{tolerance, {}};
+  BlockRow row;
+  for (int R = 0; R < blockRows; ++R) {
+    row.clear();
+    rows(R, row);
+    for (std::size_t b = 0; b < row.size(); ++b) {
+      if (b > 0 && row[b].first <= row[b - 1].first) throw SolverError("node blocks: a row's columns are not ascending");
+      distinct.add(B, row[b].first, row[b].second);
+    }
+    B.start.push_back(static_cast<int>(B.column.size()));
+  }
+  finishSplit(B, groups);
   return B;
 }
 

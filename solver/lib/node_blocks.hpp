@@ -1,9 +1,13 @@
 #pragma once
-// The beam stiffness K in 6 x 6 node blocks, for the lumped step's per-node K rows (integrators.cpp): each
-// distinct block stored once, and for rods that lie in xy-planes only the 18 entries that can be non-zero.
+// Stiffnesses in 6 x 6 node blocks, for the lumped step's per-node rows (integrators.cpp): the rods' K and the
+// elastic interfaces' (kernels.hpp elasticInterfaceBlocks); each distinct block stored once, and where a
+// stiffness never couples two groups of a node's DOFs (DofGroups) only the 18 entries that can be non-zero.
 // Plain data and inline loops; no I/O.
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
+#include <array>
+#include <functional>
+#include <utility>
 #include <vector>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -23,30 +27,46 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 typedef double DoublePair __attribute__((vector_size(16)));
 using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are stored
 
+// The two groups of three DOFs of a node (ux uy uz rx ry rz = 0..5) that a stiffness never couples, each in
+// ascending order: rods that lie in xy-planes never couple (ux, uy, rz) with (uz, rx, ry); an in-slice
+// interface (normal and arms in a yz-plane) never couples (ux, ry, rz) with (uy, uz, rx).
+struct DofGroups {
+  int first[3], second[3];
+  constexpr bool inFirst(int dof) const { return dof == first[0] || dof == first[1] || dof == first[2]; }
+  // the column that row `row` multiplies at the k-th of its three products: its own group's k-th DOF
+  constexpr int column(int row, int k) const { return inFirst(row) ? first[k] : second[k]; }
+};
+inline constexpr DofGroups kRodGroups{{0, 1, 5}, {2, 3, 4}};
+inline constexpr DofGroups kInterfaceGroups{{0, 4, 5}, {1, 2, 3}};
+
 struct NodeBlockMatrix {
   int blockRows = 0;
   std::vector<int> start;      // block row R holds blocks start[R] .. start[R + 1] - 1
   std::vector<int> column;     // block column of each block
   std::vector<int> valueOf;    // each block's entry in `values`
   std::vector<double> values;  // distinct blocks, column-major: block v, entry (i, j) at values[36 v + 6 j + i]
-  // When every block is zero between the in-plane DOFs (ux, uy, rz) and the out-of-plane ones (uz, rx, ry), as
-  // for rods that lie in xy-planes: the 18 entries that can be non-zero, per distinct block, in the order of
-  // the product's pairs (multiplyBlockRowSplit), as 9 aligned pairs; empty otherwise. splitAt: each block's
-  // first pair in `split` (9 x valueOf).
+  // When every block is zero between the two DOF groups `groups`: the 18 entries that can be non-zero, per
+  // distinct block, in the order of the product's pairs (multiplyBlockRowGroups), as 9 aligned pairs; empty
+  // otherwise. splitAt: each block's first pair in `split` (9 x valueOf).
   std::vector<DoublePair> split;
   std::vector<int> splitAt;
 };
 
-// The two DOF groups of a node that an in-plane rod's stiffness never couples, each in ascending order.
-constexpr int kInPlaneDofs[3] = {0, 1, 5}, kOutOfPlaneDofs[3] = {2, 3, 4};
+// One block row: (block column, 6 x 6 block column-major) in ascending column order.
+using BlockRow = std::vector<std::pair<int, std::array<double, 36>>>;
 
-// The 18 entries of each distinct block that can be non-zero, in multiplyBlockRowSplit's order (the layout:
-// node_blocks.cpp); empty when some block couples the in-plane and out-of-plane DOFs.
-std::vector<DoublePair> splitBlocks(const std::vector<double>& values);
+// The 18 entries of each distinct block that can be non-zero, in multiplyBlockRowGroups's order (the layout:
+// node_blocks.cpp); empty when some block couples the two groups.
+std::vector<DoublePair> splitBlocks(const std::vector<double>& values, const DofGroups& groups);
 
-// K (row-major, whole 6 x 6 blocks on node boundaries) in node blocks, with `split` filled when it applies.
-// Throws SolverError when K is not made of whole node blocks.
-NodeBlockMatrix toNodeBlocks(const SpMatRow& K);
+// K (row-major, whole 6 x 6 blocks on node boundaries) in node blocks, with `split` filled when K does not
+// couple the two groups. Throws SolverError when K is not made of whole node blocks.
+NodeBlockMatrix toNodeBlocks(const SpMatRow& K, const DofGroups& groups = kRodGroups);
+// The same from block rows given one at a time (rows(R, row) fills block row R, ascending columns); blocks
+// that agree to `tolerance` relative to their largest entry (within a binade) share the first one's values
+// (0: only blocks equal bit for bit).
+NodeBlockMatrix toNodeBlocks(int blockRows, const std::function<void(int, BlockRow&)>& rows, const DofGroups& groups,
+                             double tolerance = 0);
 
 // Block row R of K times x1 and x2, (K x1)_R and (K x2)_R, in one pass over the row (the matrix is read once
 // for both products). Each row sums its entries in ascending column order, as a compressed-row product
@@ -83,44 +103,58 @@ inline DoublePair highOf(DoublePair a) {
 #endif
 }
 
+// (a_c0, a_c1) of a node's six values a (three aligned pairs): the stored pair, a broadcast, or two picked.
+template <int c0, int c1>
+[[gnu::always_inline]] inline DoublePair pick(const DoublePair* a) {
+  if constexpr (c0 == c1) return c0 % 2 == 0 ? lowOf(a[c0 / 2]) : highOf(a[c0 / 2]);
+  else if constexpr (c0 % 2 == 0 && c1 == c0 + 1) return a[c0 / 2];
+  else return DoublePair{a[c0 / 2][c0 % 2], a[c1 / 2][c1 % 2]};
+}
+
 // s += one block's 18 entries B (9 pairs) times the node's six values a (three aligned pairs), rows paired
-// (0, 1), (2, 3), (4, 5): for k = 0, 1, 2 the in-plane column i = kInPlaneDofs[k] and the out-of-plane column
-// o = kOutOfPlaneDofs[k], so each row adds its products in ascending column order.
+// (0, 1), (2, 3), (4, 5): at the k-th product (k = 0, 1, 2) row r multiplies column G.column(r, k), so each row
+// adds its products in ascending column order.
+template <const DofGroups& G, int k, int p>
+[[gnu::always_inline]] inline void addPairProduct(const DoublePair* B, const DoublePair* a, DoublePair* s) {
+  s[p] += B[3 * k + p] * pick<G.column(2 * p, k), G.column(2 * p + 1, k)>(a);
+}
+template <const DofGroups& G>
 [[gnu::always_inline]] inline void addSplitBlock(const DoublePair* B, const DoublePair* a, DoublePair* s) {
-  const DoublePair a01 = a[0], a23 = a[1], a45 = a[2];
-  s[0] += B[0] * lowOf(a01), s[1] += B[1] * lowOf(a23), s[2] += B[2] * DoublePair{a23[0], a01[0]};
-  s[0] += B[3] * highOf(a01), s[1] += B[4] * highOf(a23), s[2] += B[5] * DoublePair{a23[1], a01[1]};
-  s[0] += B[6] * highOf(a45), s[1] += B[7] * lowOf(a45), s[2] += B[8] * a45;
+  addPairProduct<G, 0, 0>(B, a, s), addPairProduct<G, 0, 1>(B, a, s), addPairProduct<G, 0, 2>(B, a, s);
+  addPairProduct<G, 1, 0>(B, a, s), addPairProduct<G, 1, 1>(B, a, s), addPairProduct<G, 1, 2>(B, a, s);
+  addPairProduct<G, 2, 0>(B, a, s), addPairProduct<G, 2, 1>(B, a, s), addPairProduct<G, 2, 2>(B, a, s);
 }
 }  // namespace detail
 
-// multiplyBlockRow for blocks that do not couple the in-plane and out-of-plane DOFs (K.split not empty), into
+// Block row R of K times x for blocks that do not couple the groups G (K.split not empty, built for G), into
 // pairs (y[0] = rows 0-1, y[1] = rows 2-3, y[2] = rows 4-5): the 18 entries that can be non-zero instead of
-// 36, three pairs of rows at a time, rows (4, 5) paired across the groups; x1 and x2 16-byte aligned (Eigen's
-// vectors are). Every row adds the same products in the same (ascending column) order as multiplyBlockRow,
-// and the products it leaves out are exact zeros, so the result is multiplyBlockRow's (up to the sign of a
-// zero). One vector at a time: three accumulators and a block's pairs stay in the 16 SSE2 registers.
-inline void multiplyBlockRowSplitPairs(const NodeBlockMatrix& K, int R, const double* x1, const double* x2,
-                                       DoublePair* y1, DoublePair* y2) {
-  using Pair = DoublePair;
-  const Pair* split = K.split.data();
-  auto product = [&](const double* x, Pair* y) {
-    const Pair* a = static_cast<const Pair*>(__builtin_assume_aligned(x, 16));
-    Pair s[3] = {{0, 0}, {0, 0}, {0, 0}};
-    for (int b = K.start[R]; b < K.start[R + 1]; ++b) detail::addSplitBlock(split + K.splitAt[b], a + 3 * K.column[b], s);
-    y[0] = s[0], y[1] = s[1], y[2] = s[2];
-  };
-  product(x1, y1);
-  product(x2, y2);
+// 36, three pairs of rows at a time; x 16-byte aligned (Eigen's vectors are). Every row adds the same products
+// in the same (ascending column) order as multiplyBlockRow, and the products it leaves out are exact zeros, so
+// the result is multiplyBlockRow's (up to the sign of a zero). Three accumulators and a block's pairs stay in
+// the 16 SSE2 registers.
+template <const DofGroups& G>
+[[gnu::always_inline]] inline void multiplyBlockRowGroups(const NodeBlockMatrix& K, int R, const double* x,
+                                                          DoublePair* y) {
+  const DoublePair* split = K.split.data();
+  const DoublePair* a = static_cast<const DoublePair*>(__builtin_assume_aligned(x, 16));
+  DoublePair s[3] = {{0, 0}, {0, 0}, {0, 0}};
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) detail::addSplitBlock<G>(split + K.splitAt[b], a + 3 * K.column[b], s);
+  y[0] = s[0], y[1] = s[1], y[2] = s[2];
 }
 
-// multiplyBlockRowSplitPairs into 6-vectors.
-inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x1, const double* x2, Vec6& y1,
-                                  Vec6& y2) {
-  DoublePair p1[3], p2[3];
-  multiplyBlockRowSplitPairs(K, R, x1, x2, p1, p2);
-  y1 << p1[0][0], p1[0][1], p1[1][0], p1[1][1], p1[2][0], p1[2][1];
-  y2 << p2[0][0], p2[0][1], p2[1][0], p2[1][1], p2[2][0], p2[2][1];
+// The rods' K (groups kRodGroups) times x1 and x2, one vector at a time.
+inline void multiplyBlockRowSplitPairs(const NodeBlockMatrix& K, int R, const double* x1, const double* x2,
+                                       DoublePair* y1, DoublePair* y2) {
+  multiplyBlockRowGroups<kRodGroups>(K, R, x1, y1);
+  multiplyBlockRowGroups<kRodGroups>(K, R, x2, y2);
+}
+
+// multiplyBlockRowGroups<G> into a 6-vector.
+template <const DofGroups& G>
+inline void multiplyBlockRowSplit(const NodeBlockMatrix& K, int R, const double* x, Vec6& y) {
+  DoublePair p[3];
+  multiplyBlockRowGroups<G>(K, R, x, p);
+  y << p[0][0], p[0][1], p[1][0], p[1][1], p[2][0], p[2][1];
 }
 
 }  // namespace enamel

@@ -61,15 +61,17 @@ std::string percent(double fraction) {
 
 ByteCounts countBytes(const Model& m) {
   const double ni = m.numInterfaces(), nn = m.numNodes(), ne = m.numBeams();
-  const double blocks = 2.0 * ne + nn;  // K: one diagonal block per node, two off-diagonal per rod element
+  // K: one diagonal block per node, two off-diagonal per rod element; K_I: one diagonal block per node, two
+  // off-diagonal per interface
+  const double blocks = 2.0 * ne + nn + 2.0 * ni + nn;
   ByteCounts b;
-  // per interface: compact geometry (56), its two nodes (8), its due drift (8); the history only where due
-  b.interfaces = ni * (sizeof(cohesive::SliceInterface) + 8 + 8);
+  // per interface: its due drift (8); its compact geometry, its two nodes and its history only where due
+  b.interfaces = ni * 8;
   // the same on their own: also q read and f written
   b.interfacesAlone = b.interfaces + nn * (48 + 48);
   // per node: q and v_{n-1/2} read, v_{n+1/2} and q_{n+1} written, 1/m and m (6 x 6 x 8), its grip flag (1);
-  // K's blocks (column and pair index, 8 per block + 4 per row)
-  b.nodes = nn * 6 * 6 * 8 + nn + 8 * blocks + 4 * nn;
+  // K's and K_I's blocks (column and pair index, 8 per block + 4 per row of each)
+  b.nodes = nn * 6 * 6 * 8 + nn + 8 * blocks + 8 * nn;
   // q read and written, v read
   b.positions = nn * 6 * 24;
   // per rod element: its nodes (8), rod (4), strength (8), broken flag (1), ratio written (8), and one node's q
@@ -121,7 +123,7 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
       // as if the step had moved q as far as the last one did
       advanceInterfaceSchedule(m, sim.materials.law, sim.ops, sim.integrator->lastStepMoveBound(),
                                qLargest, schedule);
-      computeForcesForInterfacesScheduled(m, sim.materials.law, sim.ops, s.q, lambdaTrial, schedule, f);
+      computeInterfaceCorrectionsScheduled(m, sim.materials.law, sim.ops, s.q, lambdaTrial, schedule, f);
     }));
     checkT.push_back(secondsPerCall(
         perRound, [&] { computeStressRatiosForBeams(m, sim.materials, s.q, s.beamBroken, ratio); }));
@@ -142,10 +144,10 @@ KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
        step, bytes.interfaces + bytes.nodes + bytes.stressSchedule + p.stressComputedFraction * bytes.stressCheck},
       {"advance", "the integrator's step: the slice pass (interfaces, then per node its velocity and position)",
        advance, bytes.interfaces + bytes.nodes},
-      {"  interfaces", "per interface: its elastic force, or the law's where the schedule makes it due (the step: " +
-       percent(p.interfaceEvaluatedFraction) + " of the interfaces per step), its wrench added to both nodes (alone, with f written)",
+      {"  interfaces", "per interface: nothing while the schedule says it is elastic (its force is K_I q, in the node rows); the law where it is due (the step: " +
+       percent(p.interfaceEvaluatedFraction) + " of the interfaces per step), and off the elastic branch its force beyond the elastic one added to both nodes (alone, with f written)",
        interfaces, bytes.interfacesAlone},
-      {"  nodes", "advance - interfaces: per node K rows, v_{n+1/2}, grip residuals, damping sums, q_{n+1} = q_n + dt v_{n+1/2}",
+      {"  nodes", "advance - interfaces: per node K rows (q and v), K_I rows (q: the elastic interfaces), v_{n+1/2}, grip residuals, damping sums, q_{n+1} = q_n + dt v_{n+1/2}",
        std::max(0.0, advance - interfaces), bytes.nodes},
       {"  (positions)", "alone, for comparison: q += dt v over all DOF as a pass of its own (the step does it in the node pass)",
        positions, bytes.positions},

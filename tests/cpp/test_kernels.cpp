@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -163,7 +164,7 @@ TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
 }
 
 // The scheduled interface pass (InterfaceSchedule) along a path that fails some interfaces and comes back: the
-// same histories and failed counts as evaluating every interface by the law, forces within round-off of it;
+// same histories and failed counts as evaluating every interface by the law, forces within round-off of it (and of the elastic blocks' tolerance, kInterfaceBlockTolerance);
 // a schedule started afresh part-way (a restart) gives the same forces bit for bit; no thread count matters.
 // `keys`: further case keys (the mixed-mode law's shear_strength_ratio, whose lambda weighs shear by 1/beta^2).
 static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
@@ -175,6 +176,11 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
   std::vector<double> lmLaw(m.numInterfaces(), 0.0), lmSched = lmLaw, lmFresh = lmLaw;
   InterfaceSchedule sched, fresh;
   VecX before = VecX::Zero(n), fLaw, fSched, fFresh;
+  const NodeBlockMatrix KI = elasticInterfaceBlocks(m, law, sim.ops);
+  double elasticScale = 0;  // k A (2 + |arms|): the largest elastic force per unit of max |q|
+  for (const auto& g : sim.ops.ifacePacked)
+    elasticScale = std::max(elasticScale, law.k * g.area * (2 + std::abs(g.armAy) + std::abs(g.armAz) +
+                                                              std::abs(g.armBy) + std::abs(g.armBz)));
   long evaluated = 0;
   const int steps = 400, restartAt = 250, threads = omp_get_max_threads();
   for (int t = 0; t <= steps; ++t) {
@@ -186,14 +192,19 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
     if (t == restartAt) lmFresh = lmSched;
     const int failedLaw = computeForcesForInterfaces(m, law, sim.ops, q, lmLaw, true, fLaw);
     advanceInterfaceSchedule(m, law, sim.ops, moved, q.cwiseAbs().maxCoeff(), sched);
-    const int failedSched = computeForcesForInterfacesScheduled(m, law, sim.ops, q, lmSched, sched, fSched);
+    const int failedSched = computeForcesForInterfacesScheduled(m, law, sim.ops, KI, q, lmSched, sched, fSched);
     evaluated += sched.evaluated;
     ASSERT_EQ(failedSched, failedLaw) << "step " << t;
     for (int i = 0; i < m.numInterfaces(); ++i) ASSERT_EQ(lmSched[i], lmLaw[i]) << "step " << t << ", interface " << i;
-    ASSERT_LE((fSched - fLaw).cwiseAbs().maxCoeff(), 1e-12 * (1e-300 + fLaw.cwiseAbs().maxCoeff())) << "step " << t;
+    // K_I's blocks agree with each interface's elastic stiffness to kInterfaceBlockTolerance: an interface off the
+    // elastic branch has K_I q (its elastic force, up to that) less its exact elastic force added, so the
+    // difference is within that tolerance of the largest elastic force, k A_max |opening|_max.
+    ASSERT_LE((fSched - fLaw).cwiseAbs().maxCoeff(),
+              1e-12 * fLaw.cwiseAbs().maxCoeff() + 64 * kInterfaceBlockTolerance * elasticScale * q.cwiseAbs().maxCoeff())
+        << "step " << t;
     if (t >= restartAt) {  // lmFresh holds the histories before this step's update, as a checkpoint would
       advanceInterfaceSchedule(m, law, sim.ops, t == restartAt ? INFINITY : moved, q.cwiseAbs().maxCoeff(), fresh);
-      computeForcesForInterfacesScheduled(m, law, sim.ops, q, lmFresh, fresh, fFresh);
+      computeForcesForInterfacesScheduled(m, law, sim.ops, KI, q, lmFresh, fresh, fFresh);
       ASSERT_EQ(fFresh, fSched) << "step " << t;
       ASSERT_EQ(lmFresh, lmSched) << "step " << t;
     }
@@ -228,7 +239,8 @@ TEST(Kernels, NodeBlockProductsEqualTheSparseProduct) {
   for (int R = 0; R < K.blockRows; ++R) {
     Vec6 a1, a2, b1, b2;
     multiplyBlockRow(K, R, x1.data(), x2.data(), a1, a2);
-    multiplyBlockRowSplit(K, R, x1.data(), x2.data(), b1, b2);
+    multiplyBlockRowSplit<kRodGroups>(K, R, x1.data(), b1);
+    multiplyBlockRowSplit<kRodGroups>(K, R, x2.data(), b2);
     for (int i = 0; i < 6; ++i) {
       ASSERT_EQ(a1[i], b1[i]) << "block row " << R << ", row " << i;
       ASSERT_EQ(a2[i], b2[i]) << "block row " << R << ", row " << i;
@@ -239,6 +251,57 @@ TEST(Kernels, NodeBlockProductsEqualTheSparseProduct) {
   coupled.coeffRef(0, 2) += 1.0;  // ux of node 0 to its uz
   coupled.coeffRef(2, 0) += 1.0;
   EXPECT_TRUE(toNodeBlocks(SpMatRow(coupled)).split.empty());
+}
+
+// The elastic interfaces' stiffness in node blocks (elasticInterfaceBlocks): split by kInterfaceGroups, far
+// fewer distinct blocks than blocks (the geometry repeats from slice to slice), and K_I q within round-off
+// and the blocks' tolerance of every interface's elastic force, the law's at openings below delta0 (all elastic,
+// contact included: q of both signs) and the sum of the 12 x 12 elastic stiffnesses.
+TEST(Kernels, ElasticInterfaceBlocksGiveTheElasticForces) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const Model& m = sim.model;
+  const cohesive::Law& law = sim.materials.law;
+  const NodeBlockMatrix KI = elasticInterfaceBlocks(m, law, sim.ops);
+  ASSERT_FALSE(KI.split.empty());
+  EXPECT_LT(KI.values.size() / 36, KI.valueOf.size() / 2) << "the geometry repeats";
+  const int n = m.numDofs();
+  const VecX q = 0.02 * law.delta0() * pseudoRandomField(n, 1.0);  // openings well below delta0
+  std::vector<double> lambdaMax(m.numInterfaces(), 0.0);
+  VecX fLaw;
+  ASSERT_EQ(computeForcesForInterfaces(m, law, sim.ops, q, lambdaMax, false, fLaw), 0);
+  VecX fSum = VecX::Zero(n);
+  for (int i = 0; i < m.numInterfaces(); ++i) {
+    const Eigen::Matrix<double, 12, 12> K = cohesive::elasticStiffness(law, m.ifaceGeom[i]);
+    const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
+    Eigen::Matrix<double, 12, 1> u;
+    u << q.segment<6>(6 * A), q.segment<6>(6 * B);
+    const Eigen::Matrix<double, 12, 1> f = K * u;
+    fSum.segment<6>(6 * A) += f.head<6>(), fSum.segment<6>(6 * B) += f.tail<6>();
+  }
+  const double scale = fLaw.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0);
+  for (int R = 0; R < KI.blockRows; ++R) {
+    Vec6 y;
+    multiplyBlockRowSplit<kInterfaceGroups>(KI, R, q.data(), y);
+    ASSERT_LE((y - fLaw.segment<6>(6 * R)).cwiseAbs().maxCoeff(), 64 * kInterfaceBlockTolerance * scale) << "node " << R;
+    ASSERT_LE((y - fSum.segment<6>(6 * R)).cwiseAbs().maxCoeff(), 64 * kInterfaceBlockTolerance * scale) << "node " << R;
+  }
+}
+
+// Blocks that agree to the tolerance share one stored block; blocks that differ by more, or only bit for bit
+// at tolerance 0, do not.
+TEST(Kernels, NodeBlocksShareBlocksThatAgreeToTheTolerance) {
+  std::array<double, 36> a{}, b{}, c{};
+  for (int e = 0; e < 36; ++e) a[e] = 1.0 + e, b[e] = a[e] * (1 + 1e-14), c[e] = a[e] * (1 + 1e-9);
+  const std::vector<std::array<double, 36>> rows = {a, b, c};
+  auto build = [&](double tolerance) {
+    return toNodeBlocks(3, [&](int R, BlockRow& row) { row.push_back({R, rows[R]}); }, kRodGroups, tolerance);
+  };
+  const NodeBlockMatrix tolerant = build(kInterfaceBlockTolerance), exact = build(0);
+  EXPECT_EQ(tolerant.values.size(), 2u * 36);
+  EXPECT_EQ(tolerant.valueOf, (std::vector<int>{0, 0, 1}));
+  EXPECT_EQ(exact.values.size(), 3u * 36);
+  EXPECT_TRUE(tolerant.split.empty()) << "these blocks couple the groups";
 }
 
 // The position update (two DOFs at a time, maxima in pairs) gives the one-DOF-at-a-time loop's q bit for bit
