@@ -265,6 +265,17 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 
 // K in node blocks for the lumped step: node_blocks.hpp.
 
+// The lumped step's node rows are compiled twice where GCC builds for x86-64 (function multi-versioning), and
+// the loader picks the one the CPU runs: x86-64-v3 (AVX2, FMA) or the default x86-64. The two give the same
+// results up to round-off (FMA rounds a * b + c once); one CPU gives the same bits at any thread count.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define ENAMEL_HAS_CPU_CLONES 1
+#define ENAMEL_CPU_CLONES [[gnu::target_clones("arch=x86-64-v3", "default")]]
+#else
+#define ENAMEL_HAS_CPU_CLONES 0
+#define ENAMEL_CPU_CLONES
+#endif
+
 // Fast scheme `lumped` (ours, docs/solver.md): explicit central differences with a diagonal mass.
 //   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
 //      alpha rho Ip L / 2 per element end, alpha the smallest scale at which rotations stop governing.
@@ -344,7 +355,8 @@ class LumpedIntegrator : public Integrator {
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
       << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36
       << " distinct 6x6 stiffness blocks" << (Kblocks_.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)")
-      << ", elastic interfaces in " << KI_.values.size() / 36 << " distinct 6x6 blocks (18 entries each)";
+      << ", elastic interfaces in " << KI_.values.size() / 36 << " distinct 6x6 blocks (18 entries each), node rows "
+      << (nodeRowsForV3() ? "for x86-64-v3 (AVX2, FMA)" : "for x86-64 (this CPU has no AVX2 and FMA)");
     return o.str();
   }
 
@@ -428,11 +440,7 @@ class LumpedIntegrator : public Integrator {
 #pragma omp for schedule(static)
       for (int k = 0; k < m.numSlices; ++k) {
         failed += addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
-        SliceSums sums;
-        const int firstNode = ops.sliceNodeStart[k];
-        for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-          advanceNode(ops, step, node, q, s.vHalf.data(), wrench.data() + 6 * (node - firstNode), sums);
-        sliceSums_[k] = sums;
+        sliceSums_[k] = advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), wrench.data());
       }
     }
     ifaceSchedule_.evaluated = evaluated;
@@ -444,6 +452,27 @@ class LumpedIntegrator : public Integrator {
     double workM = 0, workK = 0;
     DoublePair largestStep = {0, 0}, largestValue = {0, 0};
   };
+
+  // Whether the loader picked advanceNodesOfSlice's x86-64-v3 clone (the test its resolver makes).
+  static bool nodeRowsForV3() {
+#if ENAMEL_HAS_CPU_CLONES
+    return __builtin_cpu_supports("x86-64-v3");
+#else
+    return false;
+#endif
+  }
+
+  // advanceNode for every node of slice k, W the wrench of its interfaces (per node of the slice, from its first).
+  // Compiled for two CPUs (target_clones), the loader picks one: x86-64-v3 (AVX2, FMA: a * b + c in one
+  // rounding where the code has one multiply and one add) where the CPU has it, else the default x86-64.
+  ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
+      const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W) {
+    SliceSums sums;
+    const int firstNode = ops.sliceNodeStart[k];
+    for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
+      advanceNode(ops, c, node, q, v, W + 6 * (node - firstNode), sums);
+    return sums;
+  }
 
   // One node's v_{n+1/2} into vNext_ from its block rows of K times q and v (= v_{n-1/2}) and of K_I times q, and
   // the wrench of its interfaces beyond their elastic force W (f_iface = K_I q - W, so r = K q + K_I q - W + b' K v),
