@@ -1,8 +1,10 @@
 #include "integrators.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -265,6 +267,9 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 
 // K in node blocks for the lumped step: node_blocks.hpp.
 
+// The wrench of a slice whose interfaces the law did not see (all elastic: their forces are in K_I q).
+alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
+
 // The lumped step's node rows are compiled twice where GCC builds for x86-64 (function multi-versioning), and
 // the loader picks the one the CPU runs: x86-64-v3 (AVX2, FMA) or the default x86-64. The two give the same
 // results up to round-off (FMA rounds a * b + c once); one CPU gives the same bits at any thread count.
@@ -322,6 +327,7 @@ class LumpedIntegrator : public Integrator {
     for (int i = 0; i < mass_.size(); ++i)
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();
+    classifyNodeMasses(m.numNodes());
     gripOfDof_.assign(m.numDofs(), -1);
     nodeHasGrip_.assign(m.numNodes(), 0);
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
@@ -439,8 +445,12 @@ class LumpedIntegrator : public Integrator {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
       for (int k = 0; k < m.numSlices; ++k) {
-        failed += addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
-        sliceSums_[k] = advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), wrench.data());
+        const SliceCorrections pass =
+            addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
+        failed += pass.failed;
+        // no wrench written: every node reads the same six zeros
+        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), wrench.data(), 6)
+                                    : advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), kNoWrench, 0);
       }
     }
     ifaceSchedule_.evaluated = evaluated;
@@ -462,15 +472,16 @@ class LumpedIntegrator : public Integrator {
 #endif
   }
 
-  // advanceNode for every node of slice k, W the wrench of its interfaces (per node of the slice, from its first).
+  // advanceNode for every node of slice k, W the wrench of its interfaces (node n's at W + stride (n - first node
+  // of the slice); stride 0: one wrench for all).
   // Compiled for two CPUs (target_clones), the loader picks one: x86-64-v3 (AVX2, FMA: a * b + c in one
   // rounding where the code has one multiply and one add) where the CPU has it, else the default x86-64.
   ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
-      const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W) {
+      const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride) {
     SliceSums sums;
     const int firstNode = ops.sliceNodeStart[k];
     for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-      advanceNode(ops, c, node, q, v, W + 6 * (node - firstNode), sums);
+      advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), sums);
     return sums;
   }
 
@@ -494,7 +505,8 @@ class LumpedIntegrator : public Integrator {
     Pair KIq[3];
     multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq);
     auto pairs = [node](const double* x) { return static_cast<const Pair*>(__builtin_assume_aligned(x + 6 * node, 16)); };
-    const Pair *vNode = pairs(v), *invM = pairs(invMass_.data()), *mass = pairs(mass_.data());
+    const NodeMass& nodeMass = nodeMasses_[massOf_[node]];
+    const Pair *vNode = pairs(v), *invM = nodeMass.invMass, *mass = nodeMass.mass;
     const Pair* Wp = static_cast<const Pair*>(__builtin_assume_aligned(W, 16));
     Pair r[3], vn[3];
     for (int j = 0; j < 3; ++j) {
@@ -526,6 +538,29 @@ class LumpedIntegrator : public Integrator {
       sums.largestStep = absMax(sums.largestStep, stepj), sums.largestValue = absMax(sums.largestValue, y);
     }
     sums.workM = workM, sums.workK = workK;
+  }
+
+  // The six masses and inverse masses of a node (equal to mass_ and invMass_ there), as pairs: they take a few
+  // distinct values (a node's rod elements and their spans decide them), kept once each and found by massOf_.
+  struct NodeMass {
+    DoublePair mass[3], invMass[3];
+  };
+  void classifyNodeMasses(int nodes) {
+    std::map<std::array<double, 12>, int> index;
+    massOf_.resize(nodes);
+    nodeMasses_.clear();
+    for (int node = 0; node < nodes; ++node) {
+      std::array<double, 12> key;
+      for (int i = 0; i < 6; ++i) key[i] = mass_[6 * node + i], key[6 + i] = invMass_[6 * node + i];
+      const auto [it, added] = index.emplace(key, static_cast<int>(nodeMasses_.size()));
+      if (added) {
+        NodeMass nm;
+        for (int j = 0; j < 3; ++j)
+          nm.mass[j] = DoublePair{key[2 * j], key[2 * j + 1]}, nm.invMass[j] = DoublePair{key[6 + 2 * j], key[7 + 2 * j]};
+        nodeMasses_.push_back(nm);
+      }
+      massOf_[node] = it->second;
+    }
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
@@ -579,6 +614,8 @@ class LumpedIntegrator : public Integrator {
   std::vector<SliceSums> sliceSums_;  // per slice
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
   NodeBlockMatrix KI_;       // the elastic interfaces' stiffness K_I in node blocks (kernels.hpp)
+  std::vector<NodeMass> nodeMasses_;  // the distinct NodeMass values
+  std::vector<int> massOf_;           // per node: its NodeMass in nodeMasses_
 };
 
 }  // namespace

@@ -160,6 +160,7 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
   if (!std::isfinite(moved) || static_cast<int>(schedule.due.size()) != m.numInterfaces()) {
     schedule.drift = 0;
     schedule.due.assign(m.numInterfaces(), 0.0);
+    schedule.sliceDue.assign(m.numSlices, 0.0);
     schedule.largestRate = 0;
     for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(law, g));
   } else {
@@ -202,27 +203,32 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
   return K;
 }
 
-[[gnu::flatten]] int addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& lawGiven,
-                                                             const Operators& ops, int k, const double* q,
-                                                             double* lambdaMax, InterfaceSchedule& schedule,
-                                                             double* wrench, long& evaluated) {
+[[gnu::flatten]] SliceCorrections addInterfaceCorrectionsOfSliceScheduled(
+    const Model& m, const cohesive::Law& lawGiven, const Operators& ops, int k, const double* q, double* lambdaMax,
+    InterfaceSchedule& schedule, double* wrench, long& evaluated) {
+  const double drift = schedule.drift, dueBelow = schedule.dueBelow;
+  SliceCorrections pass;
+  if (schedule.sliceDue[k] > dueBelow) return pass;  // none due: all elastic, their forces in K_I q
   const cohesive::Law law = lawGiven;  // a local copy, as in addInterfaceWrenchesOfSlice
-  int failed = 0;
   const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1], firstNode = ops.sliceNodeStart[k];
   std::fill(wrench, wrench + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
+  pass.wrench = true;
   const auto* nodes = m.ifaceNodes.data();
   const cohesive::SliceInterface* packed = ops.ifacePacked.data();
   double* due = schedule.due.data();
-  const double drift = schedule.drift, dueBelow = schedule.dueBelow;
+  double sliceDue = INFINITY;
   for (int i = first; i < last; ++i) {
-    if (due[i] > dueBelow) continue;  // elastic, and its force is in K_I q
-    const int A = nodes[i][0], B = nodes[i][1];
-    cohesive::Vec3 correction;
-    ++evaluated;
-    if (evaluateDueInterface(law, packed[i], q + 6 * A, q + 6 * B, drift, lambdaMax[i], due[i], failed, correction))
-      addWrenchesOfForce(packed[i], correction, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+    if (due[i] <= dueBelow) {  // otherwise elastic, and its force is in K_I q
+      const int A = nodes[i][0], B = nodes[i][1];
+      cohesive::Vec3 correction;
+      ++evaluated;
+      if (evaluateDueInterface(law, packed[i], q + 6 * A, q + 6 * B, drift, lambdaMax[i], due[i], pass.failed, correction))
+        addWrenchesOfForce(packed[i], correction, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+    }
+    sliceDue = std::min(sliceDue, due[i]);
   }
-  return failed;
+  schedule.sliceDue[k] = sliceDue;
+  return pass;
 }
 
 // Not inlined: the profile's "interfaces" kernel, which bench/step_instructions.py finds by its name.
@@ -238,9 +244,11 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
     std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
     for (int k = 0; k < m.numSlices; ++k) {
-      failed += addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(), schedule,
-                                                        wrench.data(), evaluated);
+      const SliceCorrections pass = addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(),
+                                                                            schedule, wrench.data(), evaluated);
+      failed += pass.failed;
       const int firstNode = ops.sliceNodeStart[k];
+      if (!pass.wrench) std::fill(wrench.begin(), wrench.begin() + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
       for (int dof = 6 * firstNode; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) f[dof] = -wrench[dof - 6 * firstNode];
     }
   }

@@ -60,6 +60,7 @@ struct InterfaceSchedule {
   double dueBelow = 0;        // this pass evaluates the interfaces with due <= dueBelow (drift, or all of them)
   double largestRate = 0;     // max over interfaces of c
   std::vector<double> due;    // per interface: the drift from which the law must see it again
+  std::vector<double> sliceDue;  // per slice: the smallest due of its interfaces (a slice with none due is skipped)
   long evaluated = 0;         // interfaces the last pass evaluated by the law
 };
 /// Before a pass at displacements that moved by at most `moved` (max over DOFs; infinite: start afresh) since the
@@ -80,9 +81,14 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
 /// as K_I q (elasticInterfaceBlocks) in its node rows: into wrench, per node of slice k, what the law adds to
 /// that, the wrench of (law's force - elastic force) of each interface off the elastic branch. An interface
 /// not due adds nothing (it is elastic); a due one is evaluated by the law (lambdaMax updated), adds its
-/// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. Adds the
-/// interfaces evaluated to `evaluated`; returns the number of failed interfaces of the slice.
-int addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
+/// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. A slice
+/// none of whose interfaces is due (schedule.sliceDue) is not visited, and its wrench not written. Adds the
+/// interfaces evaluated to `evaluated`.
+struct SliceCorrections {
+  int failed = 0;       // failed interfaces of the slice
+  bool wrench = false;  // the wrench was written (otherwise it is zero, and left as it was)
+};
+SliceCorrections addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
                                             const double* q, double* lambdaMax, InterfaceSchedule& schedule,
                                             double* wrench, long& evaluated);
 /// f_corr = -(the wrench of addInterfaceCorrectionsOfSliceScheduled) over all slices: the profile's
