@@ -57,8 +57,9 @@ def medians(rounds: list[tuple[dict, dict]]) -> dict:
 
 def ratios(med: dict) -> dict:
     """new / old of the medians, per key: of times for s_per_step and the kernels (< 1: faster), of speeds for
-    mdofs_per_core (the speed-up)."""
-    return {k: med["new"][k] / med["old"][k] for k in MEDIAN_KEYS}
+    mdofs_per_core (the speed-up); NaN where the old median is 0 ("check and rest" is step - advance, clipped at 0
+    when a round's advance took longer than its step)."""
+    return {k: med["new"][k] / med["old"][k] if med["old"][k] else float("nan") for k in MEDIAN_KEYS}
 
 
 def version(binary: str) -> str:

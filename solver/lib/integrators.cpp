@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
 
@@ -328,6 +332,7 @@ class LumpedIntegrator : public Integrator {
       if (mass_[i] <= 0) throw IntegratorError("node without rod mass: the lumped integrator needs every node on a rod");
     invMass_ = mass_.cwiseInverse();
     classifyNodeMasses(m.numNodes());
+    sliceReach_ = std::max(sliceReach(m, Kblocks_), sliceReach(m, KI_));
     gripOfDof_.assign(m.numDofs(), -1);
     nodeHasGrip_.assign(m.numNodes(), 0);
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
@@ -421,9 +426,10 @@ class LumpedIntegrator : public Integrator {
   //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
   //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
   //   q_{n+1} = q_n + dt v_{n+1/2}, and the slice's share of its maxima max |dt v|, max |q_{n+1}|
-  // v_{n+1/2} and q_{n+1} go to vNext_ and qNext_ (K q_n, K v_{n-1/2} of the next slice still read q_n and
-  // v_{n-1/2}) and replace them once the step's other parts are done (advancePositions).
-  // Returns the number of failed interfaces.
+  // v_{n+1/2} and q_{n+1} replace v_{n-1/2} and q_n in place once no slice still to come reads them
+  // (SliceOutputs: a slice's rows reach sliceReach_ slices either side; each thread takes one run of
+  // consecutive slices, and those its neighbours read wait for the end of the pass). Returns the number of
+  // failed interfaces.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
     const cohesive::Law law = mat.law;
     NodeStep step;
@@ -436,22 +442,27 @@ class LumpedIntegrator : public Integrator {
     qNext_.resize(s.q.size());
     sliceSums_.assign(m.numSlices, SliceSums{});
     const double* q = s.q.data();
+    const double* v = s.vHalf.data();
     double* lambda = s.lambdaMax.data();
     advanceInterfaceSchedule(m, law, ops, moveBound_, largestValue_, ifaceSchedule_);
     int failed = 0;
     long evaluated = 0;
-#pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, lambda, step)
+#pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
-#pragma omp for schedule(static)
-      for (int k = 0; k < m.numSlices; ++k) {
+      SliceOutputs out(*this, ops, m.numSlices, s);
+      for (int k = out.first; k < out.last; ++k) {
         const SliceCorrections pass =
             addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
         failed += pass.failed;
+        const SliceOutputs::Slot to = out.slotOf(k);
         // no wrench written: every node reads the same six zeros
-        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), wrench.data(), 6)
-                                    : advanceNodesOfSlice(ops, step, k, q, s.vHalf.data(), kNoWrench, 0);
+        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, v, wrench.data(), 6, to.v, to.q)
+                                    : advanceNodesOfSlice(ops, step, k, q, v, kNoWrench, 0, to.v, to.q);
+        out.replaceBefore(k);
       }
+#pragma omp barrier
+      out.replaceWaiting();
     }
     ifaceSchedule_.evaluated = evaluated;
     return failed;
@@ -463,6 +474,17 @@ class LumpedIntegrator : public Integrator {
     DoublePair largestStep = {0, 0}, largestValue = {0, 0};
   };
 
+  // The largest |slice of a block's column - slice of its row| of a node-block matrix (geometry.hpp numbers
+  // nodes slice by slice: rods join neighbouring slices, or a few apart in a reduced far field; interfaces join
+  // nodes of one slice).
+  static int sliceReach(const Model& m, const NodeBlockMatrix& K) {
+    int reach = 0;
+    for (int R = 0; R < K.blockRows; ++R)
+      for (int b = K.start[R]; b < K.start[R + 1]; ++b)
+        reach = std::max(reach, std::abs(m.nodeSlice[K.column[b]] - m.nodeSlice[R]));
+    return reach;
+  }
+
   // Whether the loader picked advanceNodesOfSlice's x86-64-v3 clone (the test its resolver makes).
   static bool nodeRowsForV3() {
 #if ENAMEL_HAS_CPU_CLONES
@@ -472,26 +494,81 @@ class LumpedIntegrator : public Integrator {
 #endif
   }
 
+  // Where each slice's v_{n+1/2} and q_{n+1} go, for one thread's run of slices first .. last - 1 (the static
+  // schedule's share of the thread), and when they replace v_{n-1/2} and q_n in the state. A slice's rows read
+  // the slices up to sliceReach_ either side, so slice k's old values are read for the last time by slice
+  // k + reach: slice k goes to a ring of reach + 1 buffers of the thread and replaces the old values once slice
+  // k + reach is done (replaceBefore). The first and the last `reach` slices of the run are read by the
+  // neighbouring threads' runs: they go to vNext_ and qNext_ and replace the old values after the pass
+  // (replaceWaiting, after a barrier). Nothing else changes: each slice computes what it did with separate
+  // old and new vectors, bit for bit.
+  struct SliceOutputs {
+    struct Slot {
+      double *v, *q;  // the slice's first node's six entries; the others follow
+    };
+    LumpedIntegrator& integ;
+    const Operators& ops;
+    State& s;
+    int first = 0, last = 0, reach = 0;
+    std::vector<double> ring;  // reach + 1 slots of 12 maxNodesPerSlice doubles: v, then q
+    SliceOutputs(LumpedIntegrator& integ, const Operators& ops, int slices, State& s)
+        : integ(integ), ops(ops), s(s), reach(integ.sliceReach_) {
+#if defined(_OPENMP)
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+#else
+      const int threads = 1, t = 0;
+#endif
+      first = static_cast<int>(static_cast<long>(slices) * t / threads);
+      last = static_cast<int>(static_cast<long>(slices) * (t + 1) / threads);
+      ring.resize(12 * static_cast<std::size_t>(ops.maxNodesPerSlice) * (reach + 1));
+    }
+    bool waits(int k) const { return k < first + reach || k >= last - reach; }
+    Slot slotOf(int k) {
+      const int node = ops.sliceNodeStart[k];
+      if (waits(k)) return {integ.vNext_.data() + 6 * node, integ.qNext_.data() + 6 * node};
+      double* slot = ring.data() + 12 * static_cast<std::size_t>(ops.maxNodesPerSlice) * (k % (reach + 1));
+      return {slot, slot + 6 * static_cast<std::size_t>(ops.maxNodesPerSlice)};
+    }
+    void replace(int k, const Slot& from) {
+      const int node = ops.sliceNodeStart[k], count = 6 * (ops.sliceNodeStart[k + 1] - node);
+      std::copy(from.v, from.v + count, s.vHalf.data() + 6 * node);
+      std::copy(from.q, from.q + count, s.q.data() + 6 * node);
+    }
+    // once slice k is done: slice k - reach, unless it waits
+    void replaceBefore(int k) {
+      const int done = k - reach;
+      if (done >= first && !waits(done)) replace(done, slotOf(done));
+    }
+    void replaceWaiting() {
+      for (int k = first; k < last; ++k)
+        if (waits(k)) replace(k, slotOf(k));
+    }
+  };
+
   // advanceNode for every node of slice k, W the wrench of its interfaces (node n's at W + stride (n - first node
-  // of the slice); stride 0: one wrench for all).
+  // of the slice); stride 0: one wrench for all), v_{n+1/2} and q_{n+1} to vOut and qOut (the slice's nodes in
+  // order, from its first).
   // Compiled for two CPUs (target_clones), the loader picks one: x86-64-v3 (AVX2, FMA: a * b + c in one
   // rounding where the code has one multiply and one add) where the CPU has it, else the default x86-64.
   ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
-      const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride) {
+      const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride,
+      double* vOut, double* qOut) {
     SliceSums sums;
     const int firstNode = ops.sliceNodeStart[k];
     for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-      advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), sums);
+      advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), vOut + 6 * (node - firstNode),
+                  qOut + 6 * (node - firstNode), sums);
     return sums;
   }
 
-  // One node's v_{n+1/2} into vNext_ from its block rows of K times q and v (= v_{n-1/2}) and of K_I times q, and
+  // One node's v_{n+1/2} into vTo from its block rows of K times q and v (= v_{n-1/2}) and of K_I times q, and
   // the wrench of its interfaces beyond their elastic force W (f_iface = K_I q - W, so r = K q + K_I q - W + b' K v),
-  // and its q_{n+1} = q_n + dt v_{n+1/2} into qNext_
+  // and its q_{n+1} = q_n + dt v_{n+1/2} into qTo
   // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv over its DOFs in order, max |dt v| and
   // max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
   [[gnu::always_inline]] inline void advanceNode(const Operators& ops, const NodeStep& c, int node, const double* q,
-                                                 const double* v, const double* W, SliceSums& sums) {
+                                                 const double* v, const double* W, double* vTo, double* qTo,
+                                                 SliceSums& sums) {
     using Pair = DoublePair;
     const NodeBlockMatrix& K = Kblocks_;
     Pair Kq[3], Kv[3];
@@ -520,12 +597,12 @@ class LumpedIntegrator : public Integrator {
         vn[j / 2][j % 2] = ops.prescribedShape[grip] * c.Vgrip;
         gripResidual_[grip] = r[j / 2][j % 2];
       }
-    auto out = [node](VecX& x) { return static_cast<Pair*>(__builtin_assume_aligned(x.data() + 6 * node, 16)); };
     auto absMax = [](Pair m, Pair a) {
       const Pair mag = a < 0 ? -a : a;
       return mag > m ? mag : m;
     };
-    Pair *vOut = out(vNext_), *qOut = out(qNext_);
+    Pair* vOut = static_cast<Pair*>(__builtin_assume_aligned(vTo, 16));
+    Pair* qOut = static_cast<Pair*>(__builtin_assume_aligned(qTo, 16));
     const Pair* qNode = pairs(q);
     double workM = sums.workM, workK = sums.workK;
     for (int j = 0; j < 3; ++j) {
@@ -569,7 +646,7 @@ class LumpedIntegrator : public Integrator {
     vGrip_.resize(vGripBefore_.size());
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
       const int dof = ops.prescribedDofs[i];
-      const double acc = (vNext_[dof] - vGripBefore_[i]) / dt_, vel = 0.5 * (vNext_[dof] + vGripBefore_[i]);
+      const double acc = (s.vHalf[dof] - vGripBefore_[i]) / dt_, vel = 0.5 * (s.vHalf[dof] + vGripBefore_[i]);
       s.reaction[i] = gripResidual_[i] + mass_[dof] * (acc + dampA_ * vel);
       vGrip_[i] = vel;
     }
@@ -582,10 +659,8 @@ class LumpedIntegrator : public Integrator {
     s.dampingWork += dt_ * (dampA_ * sumM + bEff_ * sumK);
   }
 
-  // v_{n+1/2} replaces v_{n-1/2} and q_{n+1} = q_n + dt v_{n+1/2} (both computed in the node pass) replaces q_n
-  PositionMove advancePositions(State& s) {
-    s.vHalf.swap(vNext_);
-    s.q.swap(qNext_);
+  // What the node pass's q_{n+1} = q_n + dt v_{n+1/2} moved (it has replaced q_n and v_{n-1/2} already)
+  PositionMove advancePositions(State&) {
     PositionMove move;
     for (const SliceSums& k : sliceSums_) {  // maxima: exact in any order
       move.largestStep = std::max({move.largestStep, k.largestStep[0], k.largestStep[1]});
@@ -616,6 +691,7 @@ class LumpedIntegrator : public Integrator {
   NodeBlockMatrix KI_;       // the elastic interfaces' stiffness K_I in node blocks (kernels.hpp)
   std::vector<NodeMass> nodeMasses_;  // the distinct NodeMass values
   std::vector<int> massOf_;           // per node: its NodeMass in nodeMasses_
+  int sliceReach_ = 1;                // how many slices either side a node's rows read (SliceOutputs)
 };
 
 }  // namespace

@@ -86,6 +86,13 @@ def test_medians_and_ratios_on_known_numbers():
                                    "interfaces": 0.5, "nodes": 0.5, "check and rest": 0.1 / 0.15})
 
 
+def test_a_zero_old_median_gives_no_ratio_and_no_error():
+    med = pp.medians(ROUNDS)
+    med["old"]["check and rest"] = 0.0
+    ratio = pp.ratios(med)
+    assert math.isnan(ratio["check and rest"]) and ratio["nodes"] == pytest.approx(0.5)
+
+
 def test_report_states_the_rounds_medians_and_speedup(monkeypatch):
     monkeypatch.setattr(pp, "version", lambda binary: f"0.1.0 ({binary})")
     md = pp.report("old/enamel-dem", "new/enamel-dem", ROUNDS, threads=2)
