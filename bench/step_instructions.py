@@ -10,10 +10,13 @@ thread; `enamel-dem profile --steps 10` under callgrind, collecting only inside 
 set-up is left out). Per call of each kernel (from callgrind's inclusive counts and call counts):
 
 - step: Simulation::step; advance: the integrator's advance (the slice pass and the position update);
-- interfaces: the interface pass alone (the profile's "interfaces" kernel: computeForcesForInterfacesScheduled
-  with a copy of the step's schedule; computeForcesForInterfaces in solvers before the schedule), per interface;
+- interfaces: the interface pass alone (the profile's "interfaces" kernel, with a copy of the step's schedule:
+  computeInterfaceCorrectionsScheduled, the law where it is due, in solvers that apply the elastic interfaces
+  as K_I q in the node rows; computeForcesForInterfacesScheduled, every interface's force, in solvers before
+  them; computeForcesForInterfaces in solvers before the schedule), per interface;
 - node rows and positions: advance - interfaces, per node (the profile's "nodes"; the step computes q_{n+1} in
-  its node pass, solvers before it in a pass of their own: both counted here, so the row compares);
+  its node pass, solvers before it in a pass of their own: both counted here, so the row compares; since the
+  elastic interfaces are K_I q, their forces are counted here, not under interfaces: compare the whole step);
 - positions: advancePositions alone, per DOF (the profile's "(positions)").
 
 Writes DIR/step_instructions.md (default bench/) and prints it.
