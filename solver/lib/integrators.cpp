@@ -377,7 +377,7 @@ class LumpedIntegrator : public Integrator {
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
-    const PositionMove move = advancePositions(s);
+    const PositionMove move = moveOfStep();
     advanceClock(mat.loading, s, dt_);
     const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
@@ -450,7 +450,7 @@ class LumpedIntegrator : public Integrator {
 #pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
-      SliceOutputs out(*this, ops, m.numSlices, s);
+      SliceOutputs out(ops, s, m.numSlices, sliceReach_, vNext_.data(), qNext_.data());
       for (int k = out.first; k < out.last; ++k) {
         const SliceCorrections pass =
             addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
@@ -506,13 +506,13 @@ class LumpedIntegrator : public Integrator {
     struct Slot {
       double *v, *q;  // the slice's first node's six entries; the others follow
     };
-    LumpedIntegrator& integ;
     const Operators& ops;
     State& s;
     int first = 0, last = 0, reach = 0;
-    std::vector<double> ring;  // reach + 1 slots of 12 maxNodesPerSlice doubles: v, then q
-    SliceOutputs(LumpedIntegrator& integ, const Operators& ops, int slices, State& s)
-        : integ(integ), ops(ops), s(s), reach(integ.sliceReach_) {
+    double *vWaiting, *qWaiting;  // state-sized: where the waiting slices go (vNext_, qNext_)
+    std::vector<double> ring;     // reach + 1 slots of 12 maxNodesPerSlice doubles: v, then q
+    SliceOutputs(const Operators& ops, State& s, int slices, int reach, double* vWaiting, double* qWaiting)
+        : ops(ops), s(s), reach(reach), vWaiting(vWaiting), qWaiting(qWaiting) {
 #if defined(_OPENMP)
       const int threads = omp_get_num_threads(), t = omp_get_thread_num();
 #else
@@ -525,7 +525,7 @@ class LumpedIntegrator : public Integrator {
     bool waits(int k) const { return k < first + reach || k >= last - reach; }
     Slot slotOf(int k) {
       const int node = ops.sliceNodeStart[k];
-      if (waits(k)) return {integ.vNext_.data() + 6 * node, integ.qNext_.data() + 6 * node};
+      if (waits(k)) return {vWaiting + 6 * node, qWaiting + 6 * node};
       double* slot = ring.data() + 12 * static_cast<std::size_t>(ops.maxNodesPerSlice) * (k % (reach + 1));
       return {slot, slot + 6 * static_cast<std::size_t>(ops.maxNodesPerSlice)};
     }
@@ -660,7 +660,7 @@ class LumpedIntegrator : public Integrator {
   }
 
   // What the node pass's q_{n+1} = q_n + dt v_{n+1/2} moved (it has replaced q_n and v_{n-1/2} already)
-  PositionMove advancePositions(State&) {
+  PositionMove moveOfStep() const {
     PositionMove move;
     for (const SliceSums& k : sliceSums_) {  // maxima: exact in any order
       move.largestStep = std::max({move.largestStep, k.largestStep[0], k.largestStep[1]});
