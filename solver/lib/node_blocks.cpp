@@ -10,19 +10,17 @@
 
 namespace enamel {
 
-// split's layout: for k = 0, 1, 2 and the row pairs p = (0, 1), (2, 3), (4, 5), the pair (B(r0, c0), B(r1, c1))
-// with c = groups.column(r, k): each row takes its own group's columns in ascending order. Empty when some block
-// couples the groups.
-std::vector<DoublePair> splitBlocks(const std::vector<double>& values, const DofGroups& groups) {
-  std::vector<DoublePair> split;
+// split's layout (NodeBlockMatrix::split): per block, group first then second, column k = 0, 1, 2 of the group's
+// 3 x 3 block padded with a zero. Empty when some block couples the groups.
+std::vector<StoredQuad> splitBlocks(const std::vector<double>& values, const DofGroups& groups) {
+  std::vector<StoredQuad> split;
   for (std::size_t v = 0; 36 * v < values.size(); ++v) {
     auto B = [&](int i, int j) { return values[36 * v + 6 * j + i]; };
     for (int i : groups.first)
       for (int j : groups.second)
         if (B(i, j) != 0.0 || B(j, i) != 0.0) return {};
-    for (int k = 0; k < 3; ++k)
-      for (int r = 0; r < 6; r += 2)
-        split.push_back(DoublePair{B(r, groups.column(r, k)), B(r + 1, groups.column(r + 1, k))});
+    for (const int* g : {groups.first, groups.second})
+      for (int k = 0; k < 3; ++k) split.push_back({DoubleQuad{B(g[0], g[k]), B(g[1], g[k]), B(g[2], g[k]), 0.0}});
   }
   return split;
 }
@@ -56,8 +54,9 @@ struct DistinctBlocks {
 
 void finishSplit(NodeBlockMatrix& B, const DofGroups& groups) {
   B.split = splitBlocks(B.values, groups);
-  if (!B.split.empty())
-    for (int v : B.valueOf) B.splitAt.push_back(9 * v);
+  if (B.split.empty()) return;
+  B.splitRef.resize(B.column.size());
+  for (std::size_t b = 0; b < B.column.size(); ++b) B.splitRef[b] = {6 * B.valueOf[b], 6 * B.column[b]};
 }
 }  // namespace
 

@@ -9,9 +9,6 @@
 #include <functional>
 #include <utility>
 #include <vector>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace enamel {
 
@@ -25,6 +22,14 @@ using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 // Two doubles side by side (GCC/Clang vector extension: one SSE2 register): the lumped step's paired loops.
 typedef double DoublePair __attribute__((vector_size(16)));
+// Four doubles side by side (one AVX register where the code is compiled for AVX, two SSE2 registers elsewhere):
+// a column of a 3 x 3 group block, padded with a zero.
+typedef double DoubleQuad __attribute__((vector_size(32)));
+// A quad as the element of a std::vector: alignas makes the allocation 32-byte aligned (aligned new), which a
+// vector type as a template argument does not guarantee.
+struct alignas(32) StoredQuad {
+  DoubleQuad q;
+};
 using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are stored
 
 // The two groups of three DOFs of a node (ux uy uz rx ry rz = 0..5) that a stiffness never couples, each in
@@ -35,6 +40,11 @@ struct DofGroups {
   constexpr bool inFirst(int dof) const { return dof == first[0] || dof == first[1] || dof == first[2]; }
   // the column that row `row` multiplies at the k-th of its three products: its own group's k-th DOF
   constexpr int column(int row, int k) const { return inFirst(row) ? first[k] : second[k]; }
+  // where row `row` stands in its group (0, 1, 2)
+  constexpr int laneOf(int row) const {
+    const int* g = inFirst(row) ? first : second;
+    return row == g[0] ? 0 : row == g[1] ? 1 : 2;
+  }
 };
 inline constexpr DofGroups kRodGroups{{0, 1, 5}, {2, 3, 4}};
 inline constexpr DofGroups kInterfaceGroups{{0, 4, 5}, {1, 2, 3}};
@@ -45,19 +55,25 @@ struct NodeBlockMatrix {
   std::vector<int> column;     // block column of each block
   std::vector<int> valueOf;    // each block's entry in `values`
   std::vector<double> values;  // distinct blocks, column-major: block v, entry (i, j) at values[36 v + 6 j + i]
-  // When every block is zero between the two DOF groups `groups`: the 18 entries that can be non-zero, per
-  // distinct block, in the order of the product's pairs (multiplyBlockRowGroups), as 9 aligned pairs; empty
-  // otherwise. splitAt: each block's first pair in `split` (9 x valueOf).
-  std::vector<DoublePair> split;
-  std::vector<int> splitAt;
+  // When every block is zero between the two DOF groups `groups`: per distinct block, the 18 entries that can be
+  // non-zero as its two 3 x 3 group blocks, column by column, each column a quad padded with a zero: for the
+  // group g = groups.first, then groups.second, and k = 0, 1, 2 the quad (B(g0, gk), B(g1, gk), B(g2, gk), 0).
+  // Block v's six quads start at split[6 v]. Empty otherwise.
+  std::vector<StoredQuad> split;
+  // With split: each block's first quad in split (6 valueOf) and the first DOF of its block column (6 column),
+  // side by side, so that the products' loops read one pair per block and compute no index.
+  struct SplitRef {
+    int quad, dof;
+  };
+  std::vector<SplitRef> splitRef;
 };
 
 // One block row: (block column, 6 x 6 block column-major) in ascending column order.
 using BlockRow = std::vector<std::pair<int, std::array<double, 36>>>;
 
-// The 18 entries of each distinct block that can be non-zero, in multiplyBlockRowGroups's order (the layout:
-// node_blocks.cpp); empty when some block couples the two groups.
-std::vector<DoublePair> splitBlocks(const std::vector<double>& values, const DofGroups& groups);
+// The 18 entries of each distinct block that can be non-zero, as NodeBlockMatrix::split lays them out; empty when
+// some block couples the two groups.
+std::vector<StoredQuad> splitBlocks(const std::vector<double>& values, const DofGroups& groups);
 
 // K (row-major, whole 6 x 6 blocks on node boundaries) in node blocks, with `split` filled when K does not
 // couple the two groups. Throws SolverError when K is not made of whole node blocks.
@@ -87,66 +103,61 @@ inline void multiplyBlockRow(const NodeBlockMatrix& K, int R, const double* x1, 
 }
 
 namespace detail {
-// (x0, x0) and (x1, x1) of a pair (x0, x1): one SSE2 shuffle each where there is SSE2
-inline DoublePair lowOf(DoublePair a) {
-#if defined(__SSE2__)
-  return reinterpret_cast<DoublePair>(_mm_shuffle_epi32(reinterpret_cast<__m128i>(a), 0x44));
-#else
-  return DoublePair{a[0], a[0]};
-#endif
-}
-inline DoublePair highOf(DoublePair a) {
-#if defined(__SSE2__)
-  return reinterpret_cast<DoublePair>(_mm_shuffle_epi32(reinterpret_cast<__m128i>(a), 0xEE));
-#else
-  return DoublePair{a[1], a[1]};
-#endif
-}
-
-// (a_c0, a_c1) of a node's six values a (three aligned pairs): the stored pair, a broadcast, or two picked.
-template <int c0, int c1>
-[[gnu::always_inline]] inline DoublePair pick(const DoublePair* a) {
-  if constexpr (c0 == c1) return c0 % 2 == 0 ? lowOf(a[c0 / 2]) : highOf(a[c0 / 2]);
-  else if constexpr (c0 % 2 == 0 && c1 == c0 + 1) return a[c0 / 2];
-  else return DoublePair{a[c0 / 2][c0 % 2], a[c1 / 2][c1 % 2]};
-}
-
-// s += one block's 18 entries B (9 pairs) times the node's six values a (three aligned pairs), rows paired
-// (0, 1), (2, 3), (4, 5): at the k-th product (k = 0, 1, 2) row r multiplies column G.column(r, k), so each row
-// adds its products in ascending column order.
-template <const DofGroups& G, int k, int p>
-[[gnu::always_inline]] inline void addPairProduct(const DoublePair* B, const DoublePair* a, DoublePair* s) {
-  s[p] += B[3 * k + p] * pick<G.column(2 * p, k), G.column(2 * p + 1, k)>(a);
-}
+// s1 += group G.first's 3 x 3 block times the node's values a at G.first's DOFs, s2 the same for G.second; B the
+// block's six quads (NodeBlockMatrix::split), column k = 0, 1, 2 in turn: each row adds its products in ascending
+// column order. The padding lane adds zeros.
 template <const DofGroups& G>
-[[gnu::always_inline]] inline void addSplitBlock(const DoublePair* B, const DoublePair* a, DoublePair* s) {
-  addPairProduct<G, 0, 0>(B, a, s), addPairProduct<G, 0, 1>(B, a, s), addPairProduct<G, 0, 2>(B, a, s);
-  addPairProduct<G, 1, 0>(B, a, s), addPairProduct<G, 1, 1>(B, a, s), addPairProduct<G, 1, 2>(B, a, s);
-  addPairProduct<G, 2, 0>(B, a, s), addPairProduct<G, 2, 1>(B, a, s), addPairProduct<G, 2, 2>(B, a, s);
+[[gnu::always_inline]] inline void addGroupBlocks(const DoubleQuad* B, const double* a, DoubleQuad& s1, DoubleQuad& s2) {
+  s1 += B[0] * a[G.first[0]], s2 += B[3] * a[G.second[0]];
+  s1 += B[1] * a[G.first[1]], s2 += B[4] * a[G.second[1]];
+  s1 += B[2] * a[G.first[2]], s2 += B[5] * a[G.second[2]];
+}
+
+// row `row` of a product held by group (s1: G.first's rows, s2: G.second's)
+template <const DofGroups& G, int row>
+[[gnu::always_inline]] inline double rowOf(const DoubleQuad& s1, const DoubleQuad& s2) {
+  if constexpr (G.inFirst(row)) return s1[G.laneOf(row)];
+  else return s2[G.laneOf(row)];
+}
+// the product by group into pairs of rows (0, 1), (2, 3), (4, 5)
+template <const DofGroups& G>
+[[gnu::always_inline]] inline void toPairs(const DoubleQuad& s1, const DoubleQuad& s2, DoublePair* y) {
+  y[0] = DoublePair{rowOf<G, 0>(s1, s2), rowOf<G, 1>(s1, s2)};
+  y[1] = DoublePair{rowOf<G, 2>(s1, s2), rowOf<G, 3>(s1, s2)};
+  y[2] = DoublePair{rowOf<G, 4>(s1, s2), rowOf<G, 5>(s1, s2)};
 }
 }  // namespace detail
 
 // Block row R of K times x for blocks that do not couple the groups G (K.split not empty, built for G), into
 // pairs (y[0] = rows 0-1, y[1] = rows 2-3, y[2] = rows 4-5): the 18 entries that can be non-zero instead of
-// 36, three pairs of rows at a time; x 16-byte aligned (Eigen's vectors are). Every row adds the same products
-// in the same (ascending column) order as multiplyBlockRow, and the products it leaves out are exact zeros, so
-// the result is multiplyBlockRow's (up to the sign of a zero). Three accumulators and a block's pairs stay in
-// the 16 SSE2 registers.
+// 36, each group's three rows at a time. Every row adds the same products in the same (ascending column) order
+// as multiplyBlockRow, and the products it leaves out are exact zeros, so the result is multiplyBlockRow's (up
+// to the sign of a zero).
 template <const DofGroups& G>
 [[gnu::always_inline]] inline void multiplyBlockRowGroups(const NodeBlockMatrix& K, int R, const double* x,
                                                           DoublePair* y) {
-  const DoublePair* split = K.split.data();
-  const DoublePair* a = static_cast<const DoublePair*>(__builtin_assume_aligned(x, 16));
-  DoublePair s[3] = {{0, 0}, {0, 0}, {0, 0}};
-  for (int b = K.start[R]; b < K.start[R + 1]; ++b) detail::addSplitBlock<G>(split + K.splitAt[b], a + 3 * K.column[b], s);
-  y[0] = s[0], y[1] = s[1], y[2] = s[2];
+  const DoubleQuad* split = &K.split.data()->q;
+  const NodeBlockMatrix::SplitRef* ref = K.splitRef.data();
+  DoubleQuad s1 = {}, s2 = {};
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) detail::addGroupBlocks<G>(split + ref[b].quad, x + ref[b].dof, s1, s2);
+  detail::toPairs<G>(s1, s2, y);
 }
 
-// The rods' K (groups kRodGroups) times x1 and x2, one vector at a time.
+// The rods' K (groups kRodGroups) times x1 and x2 in one pass over the row: each product as
+// multiplyBlockRowGroups's, bit for bit; the four sums side by side give the CPU four chains of additions.
 inline void multiplyBlockRowSplitPairs(const NodeBlockMatrix& K, int R, const double* x1, const double* x2,
                                        DoublePair* y1, DoublePair* y2) {
-  multiplyBlockRowGroups<kRodGroups>(K, R, x1, y1);
-  multiplyBlockRowGroups<kRodGroups>(K, R, x2, y2);
+  const DoubleQuad* split = &K.split.data()->q;
+  const NodeBlockMatrix::SplitRef* ref = K.splitRef.data();
+  DoubleQuad s1 = {}, s2 = {}, t1 = {}, t2 = {};
+  for (int b = K.start[R]; b < K.start[R + 1]; ++b) {
+    const DoubleQuad* B = split + ref[b].quad;
+    const int c = ref[b].dof;
+    detail::addGroupBlocks<kRodGroups>(B, x1 + c, s1, s2);
+    detail::addGroupBlocks<kRodGroups>(B, x2 + c, t1, t2);
+  }
+  detail::toPairs<kRodGroups>(s1, s2, y1);
+  detail::toPairs<kRodGroups>(t1, t2, y2);
 }
 
 // multiplyBlockRowGroups<G> into a 6-vector.

@@ -241,9 +241,13 @@ TEST(Kernels, NodeBlockProductsEqualTheSparseProduct) {
     multiplyBlockRow(K, R, x1.data(), x2.data(), a1, a2);
     multiplyBlockRowSplit<kRodGroups>(K, R, x1.data(), b1);
     multiplyBlockRowSplit<kRodGroups>(K, R, x2.data(), b2);
+    DoublePair c1[3], c2[3];  // both vectors in one pass, as the lumped step takes them
+    multiplyBlockRowSplitPairs(K, R, x1.data(), x2.data(), c1, c2);
     for (int i = 0; i < 6; ++i) {
       ASSERT_EQ(a1[i], b1[i]) << "block row " << R << ", row " << i;
       ASSERT_EQ(a2[i], b2[i]) << "block row " << R << ", row " << i;
+      ASSERT_EQ(a1[i], c1[i / 2][i % 2]) << "block row " << R << ", row " << i;
+      ASSERT_EQ(a2[i], c2[i / 2][i % 2]) << "block row " << R << ", row " << i;
     }
     ASSERT_LE((a1 - Kx1.segment<6>(6 * R)).cwiseAbs().maxCoeff(), 1e-12 * (1 + Kx1.cwiseAbs().maxCoeff()));
   }
