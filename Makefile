@@ -117,7 +117,7 @@ clean:
 	rm -rf $(BUILD_DIR)
 
 bench: $(ENAMEL)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.run_bench --jobs $(JOBS)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS)
 
 # The interface-ductility identification study (studies/identify/README.md); resumable, niced runs in
 # runs/identify/, report in studies/identify/. IDENTIFY_ARGS: e.g. --stages ab --stop-starting 02:15.
