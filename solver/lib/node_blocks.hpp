@@ -38,8 +38,6 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;  // column-major, as the blocks are st
 struct DofGroups {
   int first[3], second[3];
   constexpr bool inFirst(int dof) const { return dof == first[0] || dof == first[1] || dof == first[2]; }
-  // the column that row `row` multiplies at the k-th of its three products: its own group's k-th DOF
-  constexpr int column(int row, int k) const { return inFirst(row) ? first[k] : second[k]; }
   // where row `row` stands in its group (0, 1, 2)
   constexpr int laneOf(int row) const {
     const int* g = inFirst(row) ? first : second;
