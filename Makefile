@@ -19,8 +19,8 @@
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
-#   make bench          speed against error of every integrator and knob, and cost growth, in one run (~2.5 h on
-#                       2 cores at G = 10, the default since 6008856; 100 min at G = 3): bench/results.csv,
+#   make bench          speed against error of every integrator and knob, and cost growth, in one run (~100 min on
+#                       2 cores; its cases at G = 3, set in bench/run_bench.py): bench/results.csv,
 #                       bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md

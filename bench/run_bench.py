@@ -50,6 +50,10 @@ ERROR_BOUND = metrics.TOL_RATE_SPEED   # the measure's tolerance for speed check
 PRESET = "reduced"
 CASES = ["theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1"]
 REFERENCE = "paper"
+# The physics the bench's cases are run with beyond their case files: the interface fracture energy of the bench's
+# rows since 2026-11-23 (G = Gamma_i k / sigma0^2 = 3), set here so that a change of the solver's default (10 since
+# 6008856) does not change what the bench measures. At G = 10 its `paper` references take ~2 h each (2026-12-05).
+BENCH_PHYSICS = {"Gamma_k_over_sigma0sq": 3}
 
 # Variants: name -> (--set overrides, threads). `paper` is the reference. dt_factor is dt over the smallest
 # period of the integrator's own system (lumped: stable up to ~0.187 with damping_cap 1, ~0.236 with 0.5).
@@ -102,7 +106,7 @@ def profile_markdown(preset: str, threads_list=(1, 2), extra_sets: dict | None =
     """`enamel-dem profile` of PROFILE_CASE at `preset`, once per thread count, as Markdown sections."""
     out = []
     for threads in threads_list:
-        sets = dict(PROFILE_SETS, threads=threads, **(extra_sets or {}))
+        sets = dict(PROFILE_SETS, threads=threads, **BENCH_PHYSICS, **(extra_sets or {}))
         args = [str(solver()), "profile", str(paths.PAPER_CASES / f"{PROFILE_CASE}.toml"), "--preset", preset]
         for k, v in sets.items():
             args += ["--set", f"{k}={v}"]
@@ -194,7 +198,8 @@ def speed_error_jobs(cases, variants, preset, runs: pathlib.Path, extra_sets: di
             out = variant_dir(runs, case, name)
             expected = 100.0 if name == REFERENCE else 1.0 / threads
             jobs.append(Job(case=case, variant=name, cores=threads, out=out, expected_s=expected,
-                            args=run_args(paths.case_file(case), preset, {**sets, **extra_sets}, threads, out)))
+                            args=run_args(paths.case_file(case), preset, {**sets, **BENCH_PHYSICS, **extra_sets},
+                                          threads, out)))
     return jobs
 
 
@@ -248,7 +253,7 @@ def cost_jobs(runs: pathlib.Path, sizes, integrators, extra_sets: dict) -> list[
             steps = int(min(20000, max(50 if integ == "paper" else 100, COST_WORK[integ] / dof_est)))
             out = runs / "cost" / f"{integ}_w{w}_h{h}_he{he}"
             sets = {**VARIANTS[integ][0], "w_s_over_d": w, "h_s_over_d": h, "h_e_over_d": he,
-                    "max_steps": steps, **extra_sets}
+                    "max_steps": steps, **BENCH_PHYSICS, **extra_sets}
             jobs.append(Job(case="cost", variant=integ, cores=1, out=out, expected_s=dof_est * 1e-9,
                             args=run_args(paths.case_file(COST_CASE), PRESET, sets, 1, out)))
     return jobs
@@ -390,7 +395,8 @@ def fmt(v, spec=".3g"):
 
 def summary_markdown(rows, crows, header: dict) -> str:
     L = [f"# Bench results ({header['date']})", "",
-         f"Machine: {header['machine']}. Solver {header['git']}. Preset `{header['preset']}`; "
+         f"Machine: {header['machine']}. Solver {header['git']}. Preset `{header['preset']}`, "
+         f"{', '.join(f'{k} = {v}' for k, v in BENCH_PHYSICS.items())}; "
          f"{header['jobs']} runs at a time; whole bench {header['total_min']:.0f} min. "
          f"Reference: `{REFERENCE}` at the preset's rate (the slowest measured). "
          f"Bound: the same R-curve as the reference (`enamel_results.metrics.same_rcurve`: R averaged over crack "
