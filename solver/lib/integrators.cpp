@@ -421,7 +421,8 @@ class LumpedIntegrator : public Integrator {
   //   the wrench W of its interfaces on its nodes beyond their elastic force: the law's (opening, law, force
   //     on B) of those the schedule makes due (InterfaceSchedule, kernels.hpp), their history updated at q_n,
   //     less the elastic force of those off the elastic branch
-  //   per node (advanceNode): K q_n, K_I q_n and K v_{n-1/2} (its block rows), r = K q + K_I q - W + b' K v,
+  //   per node: K_I q_n (its block row; all the slice's nodes first), then (advanceNode) K q_n and K v_{n-1/2}
+  //     (its block rows), r = K q + K_I q - W + b' K v,
   //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
   //     v_{n+1/2} = shape V(t_n + dt/2) and r kept for their reactions
   //   the slice's share of the damping work's sums v.Mv and v.Kv_{n-1/2}
@@ -450,6 +451,7 @@ class LumpedIntegrator : public Integrator {
 #pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
+      std::vector<DoublePair> elastic(3 * static_cast<std::size_t>(ops.maxNodesPerSlice));
       SliceOutputs out(ops, s, m.numSlices, sliceReach_, vNext_.data(), qNext_.data());
       for (int k = out.first; k < out.last; ++k) {
         const SliceCorrections pass =
@@ -457,8 +459,8 @@ class LumpedIntegrator : public Integrator {
         failed += pass.failed;
         const SliceOutputs::Slot to = out.slotOf(k);
         // no wrench written: every node reads the same six zeros
-        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, v, wrench.data(), 6, to.v, to.q)
-                                    : advanceNodesOfSlice(ops, step, k, q, v, kNoWrench, 0, to.v, to.q);
+        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, v, wrench.data(), 6, elastic.data(), to.v, to.q)
+                                    : advanceNodesOfSlice(ops, step, k, q, v, kNoWrench, 0, elastic.data(), to.v, to.q);
         out.replaceBefore(k);
       }
 #pragma omp barrier
@@ -545,30 +547,35 @@ class LumpedIntegrator : public Integrator {
     }
   };
 
-  // advanceNode for every node of slice k, W the wrench of its interfaces (node n's at W + stride (n - first node
-  // of the slice); stride 0: one wrench for all), v_{n+1/2} and q_{n+1} to vOut and qOut (the slice's nodes in
-  // order, from its first).
+  // K_I q_n for every node of slice k into KIq (three pairs per node, from the slice's first), then advanceNode for
+  // every node, W the wrench of its interfaces (node n's at W + stride (n - first node of the slice); stride 0: one
+  // wrench for all), v_{n+1/2} and q_{n+1} to vOut and qOut (the slice's nodes in order, from its first).
+  // K_I q_n has a loop of its own: a node's row is one chain of ~21 dependent multiply-adds, and the CPU overlaps
+  // the chains of several nodes only when nothing else stands between them in the instruction stream (with
+  // advanceNode's ~250 instructions between them, the nodes pass took 1.17x as long on the paper preset).
   // Compiled for two CPUs (target_clones), the loader picks one: x86-64-v3 (AVX2, FMA: a * b + c in one
   // rounding where the code has one multiply and one add) where the CPU has it, else the default x86-64.
   ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
       const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride,
-      double* vOut, double* qOut) {
+      DoublePair* KIq, double* vOut, double* qOut) {
     SliceSums sums;
     const int firstNode = ops.sliceNodeStart[k];
     for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-      advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), vOut + 6 * (node - firstNode),
-                  qOut + 6 * (node - firstNode), sums);
+      multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq + 3 * (node - firstNode));
+    for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
+      advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), KIq + 3 * (node - firstNode),
+                  vOut + 6 * (node - firstNode), qOut + 6 * (node - firstNode), sums);
     return sums;
   }
 
-  // One node's v_{n+1/2} into vTo from its block rows of K times q and v (= v_{n-1/2}) and of K_I times q, and
+  // One node's v_{n+1/2} into vTo from its block rows of K times q and v (= v_{n-1/2}), K_I q (KIq), and
   // the wrench of its interfaces beyond their elastic force W (f_iface = K_I q - W, so r = K q + K_I q - W + b' K v),
   // and its q_{n+1} = q_n + dt v_{n+1/2} into qTo
   // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv over its DOFs in order, max |dt v| and
   // max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
   [[gnu::always_inline]] inline void advanceNode(const Operators& ops, const NodeStep& c, int node, const double* q,
-                                                 const double* v, const double* W, double* vTo, double* qTo,
-                                                 SliceSums& sums) {
+                                                 const double* v, const double* W, const DoublePair* KIq,
+                                                 double* vTo, double* qTo, SliceSums& sums) {
     using Pair = DoublePair;
     const NodeBlockMatrix& K = Kblocks_;
     Pair Kq[3], Kv[3];
@@ -579,8 +586,6 @@ class LumpedIntegrator : public Integrator {
       multiplyBlockRow(K, node, q, v, a, b);
       for (int j = 0; j < 3; ++j) Kq[j] = Pair{a[2 * j], a[2 * j + 1]}, Kv[j] = Pair{b[2 * j], b[2 * j + 1]};
     }
-    Pair KIq[3];
-    multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq);
     auto pairs = [node](const double* x) { return static_cast<const Pair*>(__builtin_assume_aligned(x + 6 * node, 16)); };
     const NodeMass& nodeMass = nodeMasses_[massOf_[node]];
     const Pair *vNode = pairs(v), *invM = nodeMass.invMass, *mass = nodeMass.mass;
