@@ -451,7 +451,7 @@ class LumpedIntegrator : public Integrator {
 #pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
-      std::vector<DoublePair> elastic(3 * static_cast<std::size_t>(ops.maxNodesPerSlice));
+      std::vector<DoublePair> KIq(3 * static_cast<std::size_t>(ops.maxNodesPerSlice));  // the slice's K_I q_n
       SliceOutputs out(ops, s, m.numSlices, sliceReach_, vNext_.data(), qNext_.data());
       for (int k = out.first; k < out.last; ++k) {
         const SliceCorrections pass =
@@ -459,8 +459,8 @@ class LumpedIntegrator : public Integrator {
         failed += pass.failed;
         const SliceOutputs::Slot to = out.slotOf(k);
         // no wrench written: every node reads the same six zeros
-        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, v, wrench.data(), 6, elastic.data(), to.v, to.q)
-                                    : advanceNodesOfSlice(ops, step, k, q, v, kNoWrench, 0, elastic.data(), to.v, to.q);
+        sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(ops, step, k, q, v, wrench.data(), 6, KIq.data(), to.v, to.q)
+                                    : advanceNodesOfSlice(ops, step, k, q, v, kNoWrench, 0, KIq.data(), to.v, to.q);
         out.replaceBefore(k);
       }
 #pragma omp barrier
