@@ -274,12 +274,13 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
 // The wrench of a slice whose interfaces the law did not see (all elastic: their forces are in K_I q).
 alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
 
-// The lumped step's node rows are compiled twice where GCC builds for x86-64 (function multi-versioning), and
-// the loader picks the one the CPU runs: x86-64-v3 (AVX2, FMA) or the default x86-64. The two give the same
-// results up to round-off (FMA rounds a * b + c once); one CPU gives the same bits at any thread count.
+// The lumped step's node rows are compiled three times where GCC builds for x86-64 (function multi-versioning),
+// and the loader picks the one the CPU runs: x86-64-v4 (AVX-512: 32 vector registers, broadcasts folded into the
+// multiply-adds), x86-64-v3 (AVX2, FMA) or the default x86-64. The v4 and v3 copies give the same bits; the default
+// differs from them by round-off (FMA rounds a * b + c once); one CPU gives the same bits at any thread count.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define ENAMEL_HAS_CPU_CLONES 1
-#define ENAMEL_CPU_CLONES [[gnu::target_clones("arch=x86-64-v3", "default")]]
+#define ENAMEL_CPU_CLONES [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]]
 #else
 #define ENAMEL_HAS_CPU_CLONES 0
 #define ENAMEL_CPU_CLONES
@@ -317,6 +318,8 @@ class LumpedIntegrator : public Integrator {
     rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
     Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
     KI_ = elasticInterfaceBlocks(m, mat.law, ops);
+    interfaceRowsAvx512_ = cpuHasAvx512() && !KI_.split.empty();
+    if (interfaceRowsAvx512_) KIocts_ = octsOfSplit(KI_.split);
     // per element end, of an element spanning `span` slices (1 but in a reduced far field)
     auto mt = [&](int span) { return 0.5 * mat.section.rho * mat.section.A * (span * L); };
     auto jr = [&](int span) { return rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * (span * L); };
@@ -367,7 +370,7 @@ class LumpedIntegrator : public Integrator {
       << ", stiffness damping b' " << bEff_ << ", " << Kblocks_.values.size() / 36
       << " distinct 6x6 stiffness blocks" << (Kblocks_.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)")
       << ", elastic interfaces in " << KI_.values.size() / 36 << " distinct 6x6 blocks (18 entries each), node rows "
-      << (nodeRowsForV3() ? "for x86-64-v3 (AVX2, FMA)" : "for x86-64 (this CPU has no AVX2 and FMA)");
+      << nodeRowsTarget();
     return o.str();
   }
 
@@ -472,7 +475,7 @@ class LumpedIntegrator : public Integrator {
 
   // A slice's share of the damping work's two sums, and of the position update's maxima (pairs).
   struct SliceSums {
-    double workM = 0, workK = 0;
+    DoublePair workM = {0, 0}, workK = {0, 0};  // the even DOFs' sums, the odd DOFs'
     DoublePair largestStep = {0, 0}, largestValue = {0, 0};
   };
 
@@ -487,13 +490,16 @@ class LumpedIntegrator : public Integrator {
     return reach;
   }
 
-  // Whether the loader picked advanceNodesOfSlice's x86-64-v3 clone (the test its resolver makes).
-  static bool nodeRowsForV3() {
+  // Which of advanceNodesOfSlice's clones the loader picked (the tests its resolver makes), and whether K_I q
+  // takes the AVX-512 rows.
+  std::string nodeRowsTarget() const {
 #if ENAMEL_HAS_CPU_CLONES
-    return __builtin_cpu_supports("x86-64-v3");
-#else
-    return false;
+    if (__builtin_cpu_supports("x86-64-v4"))
+      return interfaceRowsAvx512_ ? "for x86-64-v4 (AVX-512; K_I rows on 8 doubles side by side)"
+                                  : "for x86-64-v4 (AVX-512)";
+    if (__builtin_cpu_supports("x86-64-v3")) return "for x86-64-v3 (AVX2, FMA)";
 #endif
+    return "for x86-64 (this CPU has no AVX2 and FMA)";
   }
 
   // Where each slice's v_{n+1/2} and q_{n+1} go, for one thread's run of slices first .. last - 1 (the static
@@ -553,16 +559,21 @@ class LumpedIntegrator : public Integrator {
   // K_I q_n has a loop of its own: a node's row is one chain of ~21 dependent multiply-adds, and the CPU overlaps
   // the chains of several nodes only when nothing else stands between them in the instruction stream (with
   // advanceNode's ~250 instructions between them, the nodes pass took 1.17x as long on the paper preset).
-  // Compiled for two CPUs (target_clones), the loader picks one: x86-64-v3 (AVX2, FMA: a * b + c in one
-  // rounding where the code has one multiply and one add) where the CPU has it, else the default x86-64.
+  // Where the CPU has AVX-512, K_I q by multiplyInterfaceRowsAvx512 (node_blocks.hpp: the same bits). Compiled
+  // for three CPUs (target_clones), the loader picks one: x86-64-v4 (AVX-512), x86-64-v3 (AVX2, FMA: a * b + c
+  // in one rounding where the code has one multiply and one add) where the CPU has them, else the default x86-64.
   ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
       const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride,
       DoublePair* KIq, double* vOut, double* qOut) {
     SliceSums sums;
     const int firstNode = ops.sliceNodeStart[k];
-    for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
-      multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq + 3 * (node - firstNode));
-    for (int node = firstNode; node < ops.sliceNodeStart[k + 1]; ++node)
+    const int lastNode = ops.sliceNodeStart[k + 1];
+    if (interfaceRowsAvx512_)
+      multiplyInterfaceRowsAvx512(KI_, KIocts_, firstNode, lastNode, q, KIq);
+    else
+      for (int node = firstNode; node < lastNode; ++node)
+        multiplyBlockRowGroups<kInterfaceGroups>(KI_, node, q, KIq + 3 * (node - firstNode));
+    for (int node = firstNode; node < lastNode; ++node)
       advanceNode(ops, c, node, q, v, W + stride * (node - firstNode), KIq + 3 * (node - firstNode),
                   vOut + 6 * (node - firstNode), qOut + 6 * (node - firstNode), sums);
     return sums;
@@ -571,8 +582,8 @@ class LumpedIntegrator : public Integrator {
   // One node's v_{n+1/2} into vTo from its block rows of K times q and v (= v_{n-1/2}), K_I q (KIq), and
   // the wrench of its interfaces beyond their elastic force W (f_iface = K_I q - W, so r = K q + K_I q - W + b' K v),
   // and its q_{n+1} = q_n + dt v_{n+1/2} into qTo
-  // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv over its DOFs in order, max |dt v| and
-  // max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
+  // (the grips' q is prescribed afterwards); the sums v.Mv and v.Kv (even and odd DOFs side by side), max |dt v|
+  // and max |q_{n+1}|. r and the free DOFs' v two at a time (the same operations per DOF); then the grips.
   [[gnu::always_inline]] inline void advanceNode(const Operators& ops, const NodeStep& c, int node, const double* q,
                                                  const double* v, const double* W, const DoublePair* KIq,
                                                  double* vTo, double* qTo, SliceSums& sums) {
@@ -603,23 +614,19 @@ class LumpedIntegrator : public Integrator {
         gripResidual_[grip] = r[j / 2][j % 2];
       }
     auto absMax = [](Pair m, Pair a) {
-      const Pair mag = a < 0 ? -a : a;
+      const Pair mag = magnitude(a);
       return mag > m ? mag : m;
     };
     Pair* vOut = static_cast<Pair*>(__builtin_assume_aligned(vTo, 16));
     Pair* qOut = static_cast<Pair*>(__builtin_assume_aligned(qTo, 16));
     const Pair* qNode = pairs(q);
-    double workM = sums.workM, workK = sums.workK;
     for (int j = 0; j < 3; ++j) {
       vOut[j] = vn[j];
-      const Pair m = vn[j] * (mass[j] * vn[j]), k = vn[j] * Kv[j];
-      workM += m[0], workK += k[0];
-      workM += m[1], workK += k[1];
+      sums.workM += vn[j] * (mass[j] * vn[j]), sums.workK += vn[j] * Kv[j];
       const Pair stepj = Pair{c.dt, c.dt} * vn[j], y = qNode[j] + stepj;
       qOut[j] = y;
       sums.largestStep = absMax(sums.largestStep, stepj), sums.largestValue = absMax(sums.largestValue, y);
     }
-    sums.workM = workM, sums.workK = workK;
   }
 
   // The six masses and inverse masses of a node (equal to mass_ and invMass_ there), as pairs: they take a few
@@ -660,7 +667,7 @@ class LumpedIntegrator : public Integrator {
   // W_damp += dt (a v_{n+1/2} . M v_{n+1/2} + b' v_{n+1/2} . K v_{n-1/2}), the sums in slice order
   void addDampingWork(State& s) const {
     double sumM = 0, sumK = 0;
-    for (const SliceSums& k : sliceSums_) { sumM += k.workM; sumK += k.workK; }
+    for (const SliceSums& k : sliceSums_) { sumM += k.workM[0] + k.workM[1]; sumK += k.workK[0] + k.workK[1]; }
     s.dampingWork += dt_ * (dampA_ * sumM + bEff_ * sumK);
   }
 
@@ -694,6 +701,8 @@ class LumpedIntegrator : public Integrator {
   std::vector<SliceSums> sliceSums_;  // per slice
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
   NodeBlockMatrix KI_;       // the elastic interfaces' stiffness K_I in node blocks (kernels.hpp)
+  bool interfaceRowsAvx512_ = false;  // K_I q by multiplyInterfaceRowsAvx512 (this CPU has AVX-512)
+  std::vector<StoredOct> KIocts_;     // with it: KI_'s blocks as octs
   std::vector<NodeMass> nodeMasses_;  // the distinct NodeMass values
   std::vector<int> massOf_;           // per node: its NodeMass in nodeMasses_
   int sliceReach_ = 1;                // how many slices either side a node's rows read (SliceOutputs)

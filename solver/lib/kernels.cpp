@@ -385,6 +385,8 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
     computeStressRatiosForBeams(m, mat, q, beamBroken, ratio);
     schedule.step = -1;
     schedule.computed = ne;
+    schedule.largestRatio = 0;
+    for (double r : ratio) schedule.largestRatio = std::max(schedule.largestRatio, r);
     return;
   }
   if (schedule.step < 0 || step != schedule.step + 1 || static_cast<int>(schedule.due.size()) != ne) {
@@ -398,7 +400,8 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
   const double drift = schedule.drift;
   double* due = schedule.due.data();
   long computed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : computed)
+  double largest = 0;
+#pragma omp parallel for schedule(static) reduction(+ : computed) reduction(max : largest)
   for (int e = 0; e < ne; ++e) {
     if (beamBroken[e]) {
       ratio[e] = 0.0;
@@ -408,11 +411,13 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
     const double strength = mat.beamStrength[e];
     const double r = stressOfBeam(m, mat, q, e) / strength;
     ratio[e] = r;
+    largest = std::max(largest, r);
     due[e] = drift + std::max(0.0, 1.0 - kStressScheduleMargin - r) * strength /
                          mat.beamStressChangeBound[m.beamClass(e)];
     ++computed;
   }
   schedule.computed = computed;
+  schedule.largestRatio = largest;
 }
 
 namespace {

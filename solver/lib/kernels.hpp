@@ -127,6 +127,8 @@ struct StressCheckSchedule {
   double drift = 0;        // bound on how far any DOF moved since the schedule started
   std::vector<double> due; // per rod element: the drift from which its stress must be computed again
   long computed = 0;       // elements computed at the last check
+  double largestRatio = 0; // the largest ratio computed at the last check: an element at 1 - kStressScheduleMargin
+                           // or above is computed at every check, so no ratio reaches 1 while this stays below
 };
 
 /// The deletion check at step `step`, the displacements having moved by at most `moved` (max over DOFs; infinite

@@ -22,6 +22,11 @@ using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 // Two doubles side by side (GCC/Clang vector extension: one SSE2 register): the lumped step's paired loops.
 typedef double DoublePair __attribute__((vector_size(16)));
+// |a| of both doubles: the sign bits cleared (one instruction; -0 gives +0).
+inline DoublePair magnitude(DoublePair a) {
+  typedef long long Bits __attribute__((vector_size(16)));
+  return reinterpret_cast<DoublePair>(reinterpret_cast<Bits>(a) & Bits{0x7fffffffffffffffLL, 0x7fffffffffffffffLL});
+}
 // Four doubles side by side (one AVX register where the code is compiled for AVX, two SSE2 registers elsewhere):
 // a column of a 3 x 3 group block, padded with a zero.
 typedef double DoubleQuad __attribute__((vector_size(32)));
@@ -157,6 +162,25 @@ inline void multiplyBlockRowSplitPairs(const NodeBlockMatrix& K, int R, const do
   detail::toPairs<kRodGroups>(s1, s2, y1);
   detail::toPairs<kRodGroups>(t1, t2, y2);
 }
+
+// A distinct block's two 3 x 3 group blocks side by side, for CPUs with AVX-512 (one 512-bit register per column):
+// column k of the first group's block in lanes 0-3 and of the second group's in lanes 4-7 (the quads 6 v + k and
+// 6 v + 3 + k of NodeBlockMatrix::split), so block v's three octs start at octs[3 v].
+struct alignas(64) StoredOct {
+  double lane[8];
+};
+std::vector<StoredOct> octsOfSplit(const std::vector<StoredQuad>& split);
+
+// Whether this CPU runs x86-64-v4 code (AVX-512 F, BW, CD, DQ, VL); false where this build has no such code.
+bool cpuHasAvx512();
+
+// multiplyBlockRowGroups<kInterfaceGroups> of rows first .. last - 1 into y (three pairs per row, the first row's
+// first), K's blocks read as octs (octsOfSplit(K.split)): a block is one load of the column node's six values,
+// three permutes and three multiply-adds instead of six broadcasts and six multiply-adds, two rows' blocks in
+// turn. Every lane adds the same products in the same order as multiplyBlockRowGroups built for x86-64-v3 (FMA),
+// so the result is that build's bit for bit. Compiled for x86-64-v4 only: call it only where cpuHasAvx512().
+void multiplyInterfaceRowsAvx512(const NodeBlockMatrix& K, const std::vector<StoredOct>& octs, int first, int last,
+                                 const double* x, DoublePair* y);
 
 // multiplyBlockRowGroups<G> into a 6-vector.
 template <const DofGroups& G>

@@ -137,6 +137,7 @@ int Simulation::deleteOverloadedBeams() {
   if (!materials.rodsBreakable) return 0;
   checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
                             stressSchedule_, beamStressRatio_);
+  if (!(stressSchedule_.largestRatio >= 1.0)) return 0;  // no ratio reached 1: nothing to look for
   lastDeleted = findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule);
   if (lastDeleted.empty()) return 0;
   for (int e : lastDeleted) {

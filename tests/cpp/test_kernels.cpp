@@ -84,7 +84,8 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
 // is run_failed (11), not out_of_range (7).
 // The scheduled deletion check (StressCheckSchedule) against the check of every element, along a path of
 // displacements that loads rods past their strength: at every step the same elements are at or above
-// 1 - margin with the same ratios bit for bit (so the same ones break), while most steps compute only a few
+// 1 - margin with the same ratios bit for bit (so the same ones break; the schedule's largest ratio reaches 1
+// at the same steps as the full check's largest and then equals it), while most steps compute only a few
 // elements; a step that moved further than the scheme says would be unsafe, so a jump (q replaced) must be
 // given as an infinite move, and then every element is computed.
 TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
@@ -120,6 +121,10 @@ TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
       }
     }
     overloadedSteps += anyOverloaded;
+    // the largest ratio reaches 1 exactly when some element's does (the step then looks for them)
+    const double largestFull = *std::max_element(full.begin(), full.end());
+    ASSERT_EQ(schedule.largestRatio >= 1.0, anyOverloaded) << "step " << n;
+    if (anyOverloaded) ASSERT_EQ(schedule.largestRatio, largestFull) << "step " << n;
     qPrev = q;
   }
   EXPECT_GT(overloadedSteps, 0);
@@ -290,6 +295,48 @@ TEST(Kernels, ElasticInterfaceBlocksGiveTheElasticForces) {
     ASSERT_LE((y - fLaw.segment<6>(6 * R)).cwiseAbs().maxCoeff(), 64 * kInterfaceBlockTolerance * scale) << "node " << R;
     ASSERT_LE((y - fSum.segment<6>(6 * R)).cwiseAbs().maxCoeff(), 64 * kInterfaceBlockTolerance * scale) << "node " << R;
   }
+}
+
+// The AVX-512 interface rows (multiplyInterfaceRowsAvx512, on CPUs that have it): every entry of K_I q bit for bit
+// the multiply-adds of multiplyBlockRowGroups in its order (per row, block by block, column k = 0, 1, 2 of each
+// group's 3 x 3 block), each rounded once (std::fma), for every row of the small case's K_I, over an odd number
+// of rows (the last row alone).
+TEST(Kernels, InterfaceRowsAvx512AreTheFusedRowsBitForBit) {
+  if (!cpuHasAvx512()) GTEST_SKIP() << "this CPU has no AVX-512";
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const NodeBlockMatrix KI = elasticInterfaceBlocks(sim.model, sim.materials.law, sim.ops);
+  ASSERT_FALSE(KI.split.empty());
+  const VecX q = pseudoRandomField(sim.model.numDofs(), 1.0);
+  const int rows = KI.blockRows - (KI.blockRows % 2 == 0 ? 1 : 0);  // odd
+  std::vector<DoublePair> y(3 * static_cast<std::size_t>(rows));
+  multiplyInterfaceRowsAvx512(KI, octsOfSplit(KI.split), 0, rows, q.data(), y.data());
+  const DofGroups& G = kInterfaceGroups;
+  for (int R = 0; R < rows; ++R) {
+    double s1[4] = {0, 0, 0, 0}, s2[4] = {0, 0, 0, 0};
+    for (int b = KI.start[R]; b < KI.start[R + 1]; ++b) {
+      const StoredQuad* B = KI.split.data() + KI.splitRef[b].quad;
+      const double* a = q.data() + KI.splitRef[b].dof;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 4; ++l) {
+          s1[l] = std::fma(B[k].q[l], a[G.first[k]], s1[l]);
+          s2[l] = std::fma(B[3 + k].q[l], a[G.second[k]], s2[l]);
+        }
+    }
+    for (int row = 0; row < 6; ++row) {
+      const double expected = G.inFirst(row) ? s1[G.laneOf(row)] : s2[G.laneOf(row)];
+      ASSERT_EQ(y[3 * R + row / 2][row % 2], expected) << "row " << R << ", DOF " << row;
+    }
+  }
+}
+
+// |a| of a pair clears the sign bits: -0 gives +0, and the magnitudes are exact.
+TEST(Kernels, MagnitudeOfAPairClearsTheSigns) {
+  const DoublePair m = magnitude(DoublePair{-1.5, 2.25});
+  EXPECT_EQ(m[0], 1.5);
+  EXPECT_EQ(m[1], 2.25);
+  const DoublePair zero = magnitude(DoublePair{-0.0, 0.0});
+  EXPECT_FALSE(std::signbit(zero[0]));
+  EXPECT_FALSE(std::signbit(zero[1]));
 }
 
 // Blocks that agree to the tolerance share one stored block; blocks that differ by more, or only bit for bit
