@@ -318,8 +318,7 @@ class LumpedIntegrator : public Integrator {
     rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
     Kblocks_ = toNodeBlocks(SpMatRow(ops.K));
     KI_ = elasticInterfaceBlocks(m, mat.law, ops);
-    interfaceRowsAvx512_ = cpuHasAvx512() && !KI_.split.empty();
-    if (interfaceRowsAvx512_) KIocts_ = octsOfSplit(KI_.split);
+    if (cpuHasAvx512()) KIocts_ = octsOfSplit(KI_.split);  // empty where K_I is not split
     // per element end, of an element spanning `span` slices (1 but in a reduced far field)
     auto mt = [&](int span) { return 0.5 * mat.section.rho * mat.section.A * (span * L); };
     auto jr = [&](int span) { return rotaryScale_ * 0.5 * mat.section.rho * mat.section.Ip * (span * L); };
@@ -494,9 +493,9 @@ class LumpedIntegrator : public Integrator {
   // takes the AVX-512 rows.
   std::string nodeRowsTarget() const {
 #if ENAMEL_HAS_CPU_CLONES
-    if (__builtin_cpu_supports("x86-64-v4"))
-      return interfaceRowsAvx512_ ? "for x86-64-v4 (AVX-512; K_I rows on 8 doubles side by side)"
-                                  : "for x86-64-v4 (AVX-512)";
+    if (cpuHasAvx512())
+      return KIocts_.empty() ? "for x86-64-v4 (AVX-512)"
+                             : "for x86-64-v4 (AVX-512; K_I rows on 8 doubles side by side)";
     if (__builtin_cpu_supports("x86-64-v3")) return "for x86-64-v3 (AVX2, FMA)";
 #endif
     return "for x86-64 (this CPU has no AVX2 and FMA)";
@@ -568,7 +567,7 @@ class LumpedIntegrator : public Integrator {
     SliceSums sums;
     const int firstNode = ops.sliceNodeStart[k];
     const int lastNode = ops.sliceNodeStart[k + 1];
-    if (interfaceRowsAvx512_)
+    if (!KIocts_.empty())
       multiplyInterfaceRowsAvx512(KI_, KIocts_, firstNode, lastNode, q, KIq);
     else
       for (int node = firstNode; node < lastNode; ++node)
@@ -701,8 +700,8 @@ class LumpedIntegrator : public Integrator {
   std::vector<SliceSums> sliceSums_;  // per slice
   NodeBlockMatrix Kblocks_;  // ops.K in node blocks, for the fused product
   NodeBlockMatrix KI_;       // the elastic interfaces' stiffness K_I in node blocks (kernels.hpp)
-  bool interfaceRowsAvx512_ = false;  // K_I q by multiplyInterfaceRowsAvx512 (this CPU has AVX-512)
-  std::vector<StoredOct> KIocts_;     // with it: KI_'s blocks as octs
+  std::vector<StoredOct> KIocts_;  // KI_'s blocks as octs where the CPU has AVX-512 (K_I q by
+                                   // multiplyInterfaceRowsAvx512); empty otherwise
   std::vector<NodeMass> nodeMasses_;  // the distinct NodeMass values
   std::vector<int> massOf_;           // per node: its NodeMass in nodeMasses_
   int sliceReach_ = 1;                // how many slices either side a node's rows read (SliceOutputs)

@@ -105,11 +105,10 @@ namespace {
 //  "most_overloaded": the element(s) with the largest stress ratio >= 1, ties within 1e-9 relative
 //                     (mirror-symmetric rods) together; the rest are re-evaluated next step.
 //  "all":             every element with ratio >= 1.
+// `worst` is the largest ratio (StressCheckSchedule::largestRatio: the deletion check's, exact whenever it is >= 1).
 std::vector<int> findOverloadedBeams(const std::vector<double>& ratio, const std::vector<std::uint8_t>& beamBroken,
-                                     const std::string& rule) {
-  double worst = 0;
-  for (double r : ratio) worst = std::max(worst, r);
-  if (worst < 1.0) return {};
+                                     const std::string& rule, double worst) {
+  if (!(worst >= 1.0)) return {};
   const double threshold = rule == "all" ? 1.0 : worst * (1.0 - 1e-9);
   std::vector<int> overloaded;
   for (std::size_t e = 0; e < ratio.size(); ++e)
@@ -137,8 +136,8 @@ int Simulation::deleteOverloadedBeams() {
   if (!materials.rodsBreakable) return 0;
   checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
                             stressSchedule_, beamStressRatio_);
-  if (!(stressSchedule_.largestRatio >= 1.0)) return 0;  // no ratio reached 1: nothing to look for
-  lastDeleted = findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule);
+  lastDeleted =
+      findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule, stressSchedule_.largestRatio);
   if (lastDeleted.empty()) return 0;
   for (int e : lastDeleted) {
     bookEnergyOfDeletedBeam(model, materials, e, integrator->usesConsistentMass(), state);
