@@ -27,10 +27,8 @@
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate
 #                       from the static start (1.3 h on 2 cores of an AMD EPYC, 2026-12-04; Ctrl-C writes a
 #                       checkpoint, the same command continues): bench/paper_preset.md, bench/out/paper_preset.png
-#   make bench-far-field  the reduced far field against the full model at 80 x 80 d (docs/solver.md; 8 runs, ~3 h on 2
-#                       cores, resumable; FF_RUNS="cv03_full cv03_m2_h22" for some): studies/far_field/record_*.json
-#   make identify       [IDENTIFY_ARGS=...]  the interface-ductility identification: niced resumable runs in
-#                       runs/identify/, report studies/identify/results.md (studies/identify/README.md)
+#   A full clone also holds the lab notebook, whose research.mk adds: make test-research (the notebook's own
+#   tests), make identify, make bench-far-field.
 #   make test-asan      C++ tests built with AddressSanitizer + UBSan (build-asan/)
 #   make fuzz           [FUZZ_SECONDS=120]  libFuzzer on the case parser (needs clang and libclang-rt-dev)
 
@@ -79,7 +77,7 @@ endif
 FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
-.PHONY: bench bench-step bench-paper bench-far-field identify help deps build test test-cpp test-python clean figures runs figures-all runs-all \
+.PHONY: bench bench-step bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all \
   vtk reference clean-runs check-preset slurm
 
 help:
@@ -119,11 +117,6 @@ clean:
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS)
 
-# The interface-ductility identification study (studies/identify/README.md); resumable, niced runs in
-# runs/identify/, report in studies/identify/. IDENTIFY_ARGS: e.g. --stages ab --stop-starting 02:15.
-identify: $(ENAMEL)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m studies.identify.identify $(IDENTIFY_ARGS)
-
 # Instructions and cache misses per kernel, per interface and per node (valgrind callgrind; independent of how
 # busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.
 bench-step: $(ENAMEL)
@@ -131,11 +124,6 @@ bench-step: $(ENAMEL)
 
 bench-paper: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m bench.paper_preset --threads $(JOBS)
-
-# Full and reduced far field of the same cases, one run each, JOBS at a time (studies/far_field/README.md).
-FF_RUNS ?=
-bench-far-field: $(ENAMEL)
-	$(PYTHON) -m studies.far_field.compare --run-all $(ENAMEL) --jobs $(JOBS) $(if $(FF_RUNS),--only $(FF_RUNS))
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.
@@ -248,3 +236,6 @@ clean-runs: check-preset
 
 # Sanitizer and fuzz targets.
 include tests/fuzz/quality.mk
+
+# The lab notebook's targets (identify, bench-far-field, test-research), where the notebook is present.
+-include research/research.mk

@@ -30,16 +30,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from bench import run_bench  # noqa: E402
-from enamel_results import records  # noqa: E402
+from bench import records  # noqa: E402
 from enamel_results import paper_values, paths, results  # noqa: E402
 from figures import plotting  # noqa: E402
 
 CASE = run_bench.CASES[0]
 # The preset's loading rate, from the static start. Twice the rate was the fastest loading within the bound at
-# 100 x 100 d and G = 3 (bench/experiments/check_100 judged by metrics.same_rcurve in studies/square/rejudged.md:
-# R averaged over (0,30] d +0.7%), but at the paper's size and G = 10 it is not: against this variant R over
-# (0,30] d -11.6%, R_init +0.9%, 30 / 31 rods (studies/square/README.md, "reported: faster loading x2"; records
-# s200_he0.3_G10 and s200_he0.3_G10_rate2, 2026-12-04, AMD EPYC). It takes about twice the steps (345 k).
+# 100 x 100 d and G = 3 (judged by metrics.same_rcurve: R averaged over (0,30] d +0.7%), but at the paper's size
+# and G = 10 it is not: against this variant R over (0,30] d -11.6%, R_init +0.9%, 30 / 31 rods (docs/results.md;
+# runs of 2026-12-04 on an AMD EPYC, solver 6008856 and later). It takes about twice the steps (345 k).
 VARIANT = "lumped cap0.5 dt0.22 static"
 PRESET = "paper"
 EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests)

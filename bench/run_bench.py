@@ -41,8 +41,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
-from enamel_results import metrics, paths, records, results  # noqa: E402
-from enamel_results.records import history_end  # noqa: E402
+from enamel_results import metrics, paths, results  # noqa: E402
+from bench import records  # noqa: E402
+from bench.records import history_end  # noqa: E402
 from enamel_results.constants import KINETIC_WARN  # noqa: E402  the solver's quasi-static warning bound
 from figures import plotting  # noqa: E402
 

@@ -31,7 +31,8 @@ import subprocess
 import sys
 import tempfile
 
-from enamel_results import paths, records
+from enamel_results import paths
+from bench import records
 
 CASE = paths.case_file("theta30_s21.4_e10_cv0")
 SETS = {"w_s_over_d": "40", "h_s_over_d": "20", "integrator": '"lumped"', "dt_factor": "0.22",

@@ -24,7 +24,7 @@ def pooled_rm(results: list, lo: float = 0.0, hi: float = 30.0) -> tuple[float, 
     return float(pts.mean()), float(pts.std()), int(pts.size)
 
 
-# --- "The same R-curve" (docs: the measure of studies/square/README.md) --------------------------------------
+# --- "The same R-curve" (docs/results.md, the measure) --------------------------------------
 # Two sawtooth R-curves are compared by their level over the crack advance, not pointwise: the pointwise L2 is
 # dominated by where the teeth fall. One definition, used by the studies, the bench and the tests.
 
@@ -111,3 +111,39 @@ def same_rcurve(a: RCurve, b: RCurve, tol: float, lo: float = RANGE_OVER_D[0],
     l2 = rcurve_rel_l2(a.da, a.R, b.da, b.R)
     same = bool(comparable and abs(mean_rel) <= tol and abs(init_rel) <= tol and rods_ok)
     return Comparison(tol, top, comparable, ma, mb, mean_rel, init_rel, ra, rb, rods_ok, windows, l2, same)
+
+
+# --- The phase average: one case over N phases of the crisscross lattice at the tip -------------------------------
+# One configuration's R-curve moves with where its large jumps fall; averaged at equal crack advance over evenly
+# spaced phases of the microstructure at the tip (the case key crisscross_phase = k / N), it is the
+# microstructure's R-curve, with the phases' spread beside it (docs/results.md).
+
+PHASE_GRID_STEP_OVER_D = 0.1
+
+
+@dataclasses.dataclass(frozen=True)
+class PhaseAverage:
+    """R at equal crack advance over the phases: `curve` the mean (an RCurve, judged by same_rcurve like any
+    other; its broken_rods the phases' mean count up to the grid's end, rounded), `low`/`high` the smallest and
+    largest phase at each grid point, `each` every phase's R on the grid."""
+    curve: RCurve
+    low: np.ndarray
+    high: np.ndarray
+    each: np.ndarray        # (phases, grid points)
+
+
+def phase_average(curves: list[RCurve], step: float = PHASE_GRID_STEP_OVER_D) -> PhaseAverage:
+    """The R-curves of one case at N phases averaged at equal Delta_a on a grid of `step` from the last of their
+    first points to the first of their last points (the range every phase covers; R between a curve's points
+    linear, as advance_mean reads it)."""
+    if len(curves) < 2:
+        raise ValueError("a phase average needs the R-curves of at least two phases")
+    lo, hi = max(float(c.da[0]) for c in curves), min(float(c.da[-1]) for c in curves)
+    if not hi > lo:
+        raise ValueError(f"the phases' R-curves share no range of crack advance ({lo:g} to {hi:g} d)")
+    grid = np.append(np.arange(lo, hi, step), hi)
+    each = np.array([np.interp(grid, c.da, c.R) for c in curves])
+    rods = [c.rods_up_to(hi) for c in curves]
+    mean_rods = None if any(r is None for r in rods) else int(round(sum(rods) / len(rods)))
+    return PhaseAverage(RCurve.of(grid, each.mean(axis=0), broken_rods=mean_rods), each.min(axis=0),
+                        each.max(axis=0), each)

@@ -60,7 +60,6 @@ EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or f
 SEAL = struct.Struct("<8sIIQ")
 SEAL_MAGIC = b"ENAMELRS"
 USERBLOCK_BYTES = 512
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 # Interface tags (/geometry/iface_tag; solver/lib/geometry.hpp InterfaceTag).
 TAG_PLY1, TAG_PLY2, TAG_INTER12, TAG_INTER21 = 0, 1, 2, 3
@@ -83,16 +82,12 @@ class DamagedResult(OSError):
 
 
 def verify_result_file(path) -> None:
-    """Raise DamagedResult unless `path` carries the solver's seal and its size and CRC-32 match (files written
-    before the seal, from 2026-12-03 back, begin with HDF5's signature: not checked here, h5py's errors on them
-    are)."""
+    """Raise DamagedResult unless `path` carries the solver's seal and its size and CRC-32 match."""
     path = pathlib.Path(path)
     with open(path, "rb") as f:
         head = f.read(USERBLOCK_BYTES)
-        if head[:len(HDF5_SIGNATURE)] == HDF5_SIGNATURE:
-            return
         if len(head) < SEAL.size or head[:len(SEAL_MAGIC)] != SEAL_MAGIC:
-            raise DamagedResult(path, "it does not begin with the enamel-dem seal or an HDF5 signature")
+            raise DamagedResult(path, "it does not begin with the enamel-dem seal")
         _, fmt, crc, size = SEAL.unpack_from(head)
         actual = path.stat().st_size
         if fmt != 1 or size != actual:
@@ -114,8 +109,7 @@ class Frame:
     iface_damage: np.ndarray    # 1 - secant stiffness / k
     beam_broken: np.ndarray     # 1 = rod element deleted
     node_displacement: np.ndarray  # (nodes, 6): ux uy uz rx ry rz, d and rad
-    beam_stress: np.ndarray | None  # (beams,), sigma0: the solver's brittle-check stress (0 for deleted elements);
-    #                                 None in files of solvers before 2026-12-02, which did not write it
+    beam_stress: np.ndarray     # (beams,), sigma0: the solver's brittle-check stress (0 for deleted elements)
 
 
 @dataclasses.dataclass
@@ -204,7 +198,7 @@ def read_frames(frames_group) -> list[Frame]:
         out.append(Frame(index=int(name), target_da=float(a["target_da_over_d"]), da=float(a["da_over_d"]),
                          step=int(a["step"]), iface_state=fg["iface_state"][:], iface_damage=fg["iface_damage"][:],
                          beam_broken=fg["beam_broken"][:], node_displacement=fg["node_displacement"][:],
-                         beam_stress=fg["beam_stress"][:] if "beam_stress" in fg else None))
+                         beam_stress=fg["beam_stress"][:]))
     return out
 
 

@@ -1,6 +1,6 @@
 // Process exit codes of enamel-dem: one per class of failure, so that scripts and tests can tell
 // a bad case file from a crashed run without parsing messages. The one definition: the Python side reads
-// this file (enamel_results/results.py EXIT_CODES), so keep one `constexpr int name = value;` per line.
+// this file (enamel_results/constants.py EXIT), so keep one `constexpr int name = value;` per line.
 #pragma once
 
 namespace enamel::exit_code {

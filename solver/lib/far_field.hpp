@@ -1,7 +1,7 @@
 #pragma once
 // The reduced far field (docs/solver.md, "Reduced far field").
 //
-// Away from the crack plane the material stays elastic (studies/scene/README.md), so it need not be resolved
+// Away from the crack plane the material stays elastic (docs/solver.md: the inelastic reach measured at the default G), so it need not be resolved
 // slice by slice. coarsenFarField keeps the full model inside the band |y - y_crack| <= fullHalfHeight and,
 // outside it, keeps a rod's node only in every m-th slice (m = farFieldSlices), at the rod's two ends and on
 // the loaded rows (the grips stay exactly as in the full model):

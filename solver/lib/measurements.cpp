@@ -68,7 +68,7 @@ double distanceFromCrackPlane(const Model& m, const std::array<int, 2>& n) {
 }  // namespace
 
 // The runner warns when the reach comes near the loaded edges (the R-curve then depends on the specimen's
-// height: studies/scene/README.md).
+// height: docs/solver.md, "Reduced far field").
 double inelasticInterfaceReach(const Model& m, const cohesive::Law& law, const State& s) {
   double reach = 0;
   for (int i = 0; i < m.numInterfaces(); ++i)

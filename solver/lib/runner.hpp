@@ -65,8 +65,7 @@ struct GuardBounds {
   double minWork = 0;     // 0.1 Gamma_i B d: below this much work the error is measured against it
   /// kinetic / strain energy while the crack grows (0.05 is the quasi-static warning). Ten times the largest
   /// ratio of any completed run measured by 2026-12-03: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
-  /// the committed records: 0.299 in studies/far_field record_cv03_m2_h22_allow, up to 0.156 in
-  /// bench/experiments/check_100), so 3.2.
+  /// 0.299 at 80 x 80 d with the reduced far field, 0.156 at 100 x 100 d: docs/solver.md), so 3.2.
   double kinetic = 3.2;
   /// An R-curve point (J when the crack advanced) below -negativeJ: negative beyond round-off (1e-6 Gamma_i: J's
   /// terms round at ~1e-13 of Gamma_i). Only R-curve points: J of a history row may go below 0 in a sound run,

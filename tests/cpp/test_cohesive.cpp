@@ -23,7 +23,7 @@ const Law kLaw = makeLaw(0.1, 1e-4, 3e-7);
 // Round-off tolerance for closed-form quantities evaluated with a handful of flops.
 constexpr double kRoundoff = 1e-12;
 // Energy from trapezoid-rule integration of the work: exact on linear pieces, O(h^2) at kinks and on
-// curved pieces; the brief asks for 1e-6 relative.
+// curved pieces; 1e-6 relative is the accuracy asked of the law's integral.
 constexpr double kWorkTol = 1e-6;
 
 // Work int t . d(opening) along the straight leg from -> to in local opening space, trapezoid rule with n

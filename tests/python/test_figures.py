@@ -101,7 +101,7 @@ def test_paper_values_entries_are_well_formed():
         assert math.isfinite(float(v["value"])), v["id"]
     for t in pv["trend"]:
         assert t["direction"] in ("increasing", "decreasing", "constant", "maximum_at_first"), t["id"]
-    # the values the brief names: 4/3 at theta_D = 0, ~7 at 15 and 30 deg, ~8 and ~6 at Er/kd = 10, 20, ~11.9
+    # the paper's values (figures/paper_values.toml): 4/3 at theta_D = 0, ~7 at 15 and 30 deg, ~8 and ~6 at Er/kd = 10, 20, ~11.9
     by_id = {v["id"]: v for v in pv["value"]}
     assert by_id["fig4_theta0_R_init"]["value"] == pytest.approx(4 / 3, rel=1e-15)
     assert by_id["fig4_theta15_R_ss"]["value"] == by_id["fig4_theta30_R_ss"]["value"] == 7.0

@@ -43,3 +43,30 @@ def test_a_long_function_is_caught(tmp_path):
                    "}  // namespace enamel\n")
     found = check_function_length.long_functions(src, 80)
     assert [(name, n) for _, name, n in found] == [("longOne", 88)]
+
+
+def test_the_product_never_depends_on_the_notebook():
+    """The lab notebook may import the product, never the reverse (tools/check_notebook.py)."""
+    from tools.check_notebook import NOTEBOOK
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "check_notebook.py")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert f"no file outside {NOTEBOOK}/ depends on it" in r.stdout
+
+
+def test_a_dependency_on_the_notebook_is_caught(tmp_path):
+    from tools import check_notebook
+    nb = check_notebook.NOTEBOOK   # the folder's name is spelled once, so that this file does not name it
+    (tmp_path / "pipeline").mkdir()
+    bad = tmp_path / "pipeline" / "jobs.py"
+    bad.write_text(f"import json\nfrom {nb}.square import square\nCSV = ROOT / '{nb}' / 'x.csv'\n")
+    cpp = tmp_path / "runner.hpp"
+    cpp.write_text(f"// a bound from {nb}/far_field/record.json\nint x = 1;\n")
+    doc = tmp_path / "notes.md"
+    doc.write_text(f"The records are in {nb}/square/README.md.\n")
+    inside = tmp_path / nb / "a.py"
+    inside.parent.mkdir()
+    inside.write_text(f"from {nb}.square import square\n")
+    found = check_notebook.violations([bad, cpp, doc, inside], root=tmp_path)
+    assert len(found) == 3, found
+    assert found[0].startswith("pipeline/jobs.py:2:") and found[1].startswith("pipeline/jobs.py:3:")
+    assert found[2].startswith("runner.hpp:1:")
