@@ -1,7 +1,11 @@
 #include "resources.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include "setup.hpp"
+#include "simulation.hpp"
 
 namespace enamel {
 
@@ -36,6 +40,92 @@ ResourceEstimate estimateResources(const CaseParams& p) {
                                     : e.nodes * kLumpedBytesPerNode);
   if (p.static_start > 0) e.memoryBytes += e.nodes * (kStaticBytesPerNode + kStaticFillBytesPerNodeSliceNode * perSlice);
   return e;
+}
+
+namespace {
+// Time of a run (estimateRunTime). Measured with the build of commit c09beab on 2026-12-06, one thread, on this
+// project's shared development machine (AMD EPYC, 2 cores shared by several sessions: timings swing, and the
+// constants take the slow side):
+// Applied displacement at the stop, at delta0 = 0.1 d (in linear kinematics every displacement scales with delta0,
+// docs/model.md): U_end = U_i + k_a stop_da_over_d. U_i is where the crack starts to grow in the ci run of
+// theta30_s21.4_e10_cv0 (16 x 8 d: Delta_a > 0 at U = 2.50 d; U_end 5.08 d at Delta_a 5.13 d, 0.52 d per d after
+// it); k_a is that run's and the median of the 80 x 80 d runs of studies/square/data at the paper's rate (U_end
+// 10.4-24.8 d at Delta_a = 30 d, median 16.5 d: (16.5 - 2.5) / 30 = 0.47). The model's 17.5 d at 30 d is 0.71x
+// (theta30_s28.5_e10_cv0, 24.8 d) to 1.68x (theta0_s21.4_e10_cv0, 10.4 d) of those runs', 1.0-1.2x of the
+// 100 x 100 d runs' (14.3-17.7 d) and 1.26x of the 200 x 200 d run's (13.9 d). U_end at a given stop does not
+// grow with h_s (16.5 d at 80 d, 13.9 d at 200 d), so h_s is not in the model.
+constexpr double kUAtInitiation = 2.5;     // d
+constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
+// The static start's U_c (first damage): 1.705 d at 200 x 200 d (the paper preset, docs/solver.md), as
+// k_c sqrt(h_s / d) (the displacement at which a crack of a stiff-gripped strip initiates grows as sqrt(h_s));
+// a low U_c skips less of the run, so k_c is on the low side of the measurements.
+constexpr double kUcPerSqrtHeight = 0.12;
+// Seconds per step. `lumped`: DOF-updates per second per core, whole ci runs' CPU time
+constexpr double kLumpedDofUpdatesPerSecond = 40e6;
+// `paper`: per DOF, and per DOF and node of a slice
+constexpr double kPaperSecondsPerDof = 2e-8, kPaperSecondsPerDofSliceNode = 3e-9;
+// Set-up: the model, its operators and the integrator, per DOF; the static start's solve, per DOF and slice node
+constexpr double kSetupSecondsPerDof = 3e-5, kStaticSecondsPerDofSliceNode = 4e-7;
+constexpr double kBlockWidth = 16, kBlockHeight = 8;  // d: the block of stepScaleOfBlock (the ci preset's size)
+constexpr double kDefaultDelta0 = 0.1;                // d: the U_end and U_c measurements' delta0
+
+// Applied displacement at the stop, d: (U_i + k_a stop_da_over_d) (delta0 / 0.1 d), at most stop_u_over_d.
+double stopDisplacement(const CaseParams& p) {
+  const double atDefaultDelta0 = kUAtInitiation + kUPerCrackAdvance * p.stop_da_over_d;
+  return std::min(p.stop_u_over_d, atDefaultDelta0 * p.delta0_over_d / kDefaultDelta0);
+}
+
+// Applied displacement at the start, d: static_start x U_c, U_c = k_c (delta0 / 0.1 d) sqrt(h_s / d) (0 from rest).
+double startDisplacement(const CaseParams& p) {
+  return p.static_start * kUcPerSqrtHeight * p.delta0_over_d / kDefaultDelta0 * std::sqrt(p.h_s_over_d);
+}
+
+// One core's seconds per step: `lumped` a DOF-update rate; `paper` also the Cholesky solve, whose cost per DOF
+// grows with the nodes of a slice (the factor's bandwidth).
+double secondsPerStep(const CaseParams& p, const ResourceEstimate& e) {
+  if (p.integrator == "paper") return e.dof * (kPaperSecondsPerDof + kPaperSecondsPerDofSliceNode * e.nodes / e.slices);
+  return e.dof / kLumpedDofUpdatesPerSecond;
+}
+
+double setupSeconds(const CaseParams& p, const ResourceEstimate& e) {
+  const double staticSolve = p.static_start > 0 ? kStaticSecondsPerDofSliceNode * e.dof * e.nodes / e.slices : 0;
+  return kSetupSecondsPerDof * e.dof + staticSolve;
+}
+}  // namespace
+
+TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s) {
+  TimeEstimate t;
+  const ResourceEstimate e = estimateResources(p);
+  Loading loading;
+  loading.vApp = p.rate_factor * p.v_app_over_cd * s.c_d;
+  loading.rampTime = p.ramp_transits * p.h_s_over_d / s.c_d;
+  t.uEnd = stopDisplacement(p);
+  t.uStart = std::min(startDisplacement(p), t.uEnd);
+  t.duration = loading.timeOfDisplacement(t.uEnd) - loading.timeOfDisplacement(t.uStart);
+  t.steps = std::ceil(t.duration / s.dt);
+  if (p.max_steps > 0) t.steps = std::min(t.steps, static_cast<double>(p.max_steps));
+  t.secondsPerStep = secondsPerStep(p, e);
+  t.setupSeconds = setupSeconds(p, e);
+  t.seconds = t.setupSeconds + t.steps * t.secondsPerStep;
+  return t;
+}
+
+StepScale stepScaleOfBlock(const CaseParams& p) {
+  StepScale s;
+  s.c_d = std::sqrt(p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p));
+  CaseParams block = p;
+  // the model's h_e is w_s / round(w_s / h_e) (geometry.cpp): the block keeps the case's, so its rod elements are
+  // the case's (the same length, so the same element frequency)
+  const double h_e = p.w_s_over_d / std::round(p.w_s_over_d / p.h_e_over_d);
+  block.h_e_over_d = h_e;
+  block.w_s_over_d = h_e * std::max(2.0, std::round(std::min(p.w_s_over_d, kBlockWidth) / h_e));
+  block.h_s_over_d = std::min(p.h_s_over_d, kBlockHeight);
+  block.far_field_slices = 1;
+  block.static_start = 0;
+  block.E_transverse_over_Er = s.c_d * s.c_d;  // the case's c_d (the block's own would differ a little)
+  block.threads = 1;
+  s.dt = Simulation(block).integrator->timeStep();
+  return s;
 }
 
 double readProcKilobytes(const char* path, const char* key) {

@@ -296,7 +296,7 @@ def test_array_requeued_mid_run_resumes_bit_for_bit_then_figures(slurm, enamel, 
     array_script = (scripts / "runs.sbatch").read_text()
     assert "#SBATCH --array=0-1" in array_script and "#SBATCH --requeue" in array_script
     assert re.search(r"#SBATCH --mem=\d+M", array_script), "memory from the solver's estimate"
-    assert re.search(r"#SBATCH --time=\d+-\d\d:\d\d:00", array_script), "time from the cost model"
+    assert re.search(r"#SBATCH --time=\d+-\d\d:\d\d:00", array_script), "time from the solver's estimate"
 
     sub = subprocess.run(["bash", str(scripts / "submit.sh")], capture_output=True, text=True, env=slurm.env,
                          timeout=60)
