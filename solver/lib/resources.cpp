@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "setup.hpp"
 #include "simulation.hpp"
@@ -122,6 +123,14 @@ TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s) {
 }
 
 StepScale stepScaleOfBlock(const CaseParams& p) {
+  // the blocks are small unless h_e is: refuse one that cannot fit before building it (measureTransverseModulus's
+  // is at most 24 x 12 d)
+  CaseParams largest = p;
+  largest.w_s_over_d = std::min(p.w_s_over_d, 24.0);
+  largest.h_s_over_d = std::min(p.h_s_over_d, 12.0);
+  largest.static_start = 0;
+  const std::string why = checkMemoryFits(largest, availableMemoryBytes());
+  if (!why.empty()) throw std::invalid_argument("the blocks that measure c_d and dt: " + why);
   StepScale s;
   s.c_d = std::sqrt(p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p));
   CaseParams block = p;
