@@ -61,7 +61,8 @@ namespace {
 constexpr double kUAtInitiation = 2.5;     // d
 constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
 // The static start's U_c (first damage, theta30_s21.4_e10_cv0): 0.272 d at h_s = 8 d, 0.529 at 20, 1.057 at 80
-// (the ci, reduced and converged presets' sizes), 1.705 at 200 (the paper preset): k_c sqrt(h_s / d) with
+// (the ci, reduced and converged presets' sizes), 1.705 at 200 (the paper preset, `make bench-paper`'s static
+// start, bench/experiments/step_rounds): k_c sqrt(h_s / d) with
 // k_c = 0.096-0.121; a low U_c skips less of the run, so k_c is on the low side of the larger sizes.
 constexpr double kUcPerSqrtHeight = 0.11;
 // Seconds per step. `lumped`: DOF-updates per second per core. Whole ci runs 52-93 M (the five cases above),
@@ -71,8 +72,8 @@ constexpr double kUcPerSqrtHeight = 0.11;
 constexpr double kLumpedDofUpdatesPerSecond = 40e6;
 // `paper` (consistent mass, CHOLMOD solve per step), per DOF: a + b x nodes of a slice (the factor's bandwidth);
 // measured 9.7e-8 s at 16 x 8 d (13.9 nodes a slice) and 1.22e-7 at 40 x 20 d (34.6), 3000 and 600 steps less
-// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench` (its cost growth as committed at c09beab). The constants give 1.11x, 1.22x and
-// 1.14x of these; at the paper preset's 346 nodes a slice they are an extrapolation.
+// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench` (its cost growth as committed at c09beab). The
+// constants give 1.11x, 1.22x and 1.14x of these; at the paper preset's 346 nodes a slice, an extrapolation.
 constexpr double kPaperSecondsPerDof = 8e-8, kPaperSecondsPerDofSliceNode = 2e-9;
 // Set-up (the model, operators, integrator, c_d's block), per DOF: 1.8e-5 s user at 80 x 80 d (a 1-step run).
 // The static start's solve, per DOF and node of a slice: 82 s on 2 cores at 200 x 200 d (3.4e-7 core-s), 91 s

@@ -77,7 +77,8 @@ TEST(RunTimeEstimate, PaperSchemeCostsMorePerStep) {
 // 40 x 20 d and -1.0% at 80 x 80 d, 2026-12-06, docs/cluster.md).
 TEST(StepScaleOfBlock, TimeStepIsTheFullModels) {
   for (const char* integrator : {"lumped", "paper"}) {
-    const CaseParams p = caseAt("ci", {"w_s_over_d=24", "h_s_over_d=12", std::string("integrator=\"") + integrator + "\""});
+    const CaseParams p =
+        caseAt("ci", {"w_s_over_d=24", "h_s_over_d=12", std::string("integrator=\"") + integrator + "\""});
     const StepScale block = stepScaleOfBlock(p);
     Simulation full(p);
     const double tolerance = std::string(integrator) == "paper" ? 1e-12 : 0.02;
