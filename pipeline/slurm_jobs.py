@@ -17,17 +17,16 @@ requeues itself (`scontrol requeue`): its next start continues the run. A SIGTER
 `scontrol requeue`, preemption) also reaches the solver, which writes its checkpoint before SLURM's KillWait
 ends; a requeued task continues, a cancelled one continues when submitted again.
 
-Resources (every task of an array gets the same): memory is the largest of the solver's own estimates
-(`enamel-dem info --estimate`) over the runs, x1.25 + 256 MB; time is the bench's cost model for one core:
-steps x DOF / (DOF-updates per second), with the steps of a whole run and the DOF-updates/s of the `lumped`
-scheme at the nearest measured size in bench/cost_growth.csv (its estimate at loading rate 1e-3 c_d, the
-slowest preset rate; x2 for half-rate twins), x2, between 10 min and 24 h (a common partition limit). A task
-that reaches its time limit is requeued and continues, so an estimate that is too short costs a wait in the
-queue, not work. --mem and --time replace the estimates.
+Resources (every task of an array gets the same), both from the solver's own estimates (`enamel-dem info
+--estimate`, which builds no model) over the runs: memory is the largest, x1.25 + 256 MB; time is the longest
+run's `seconds`, one core's wall time of the whole run (the steps from the run's loading, stop criterion and
+time step, the seconds per step from a measured DOF-update rate per integrator: docs/cluster.md), x2, between
+10 min and 24 h (a common partition limit). A half-rate twin's estimate is made with its rate_factor = 0.5, so it
+already takes twice the steps. A task that reaches its time limit is requeued and continues, so an estimate
+that is too short costs a wait in the queue, not work. --mem and --time replace the estimates.
 """
 import argparse
 import concurrent.futures
-import csv
 import math
 import os
 import pathlib
@@ -41,8 +40,8 @@ from pipeline.make_rules import figure_set  # the one place that lists the runs
 
 PROG = "slurm_jobs.py"
 MEM_FACTOR, MEM_EXTRA_MB = 1.25, 256     # memory request: solver estimate x1.25 + 256 MB (make, shell, HDF5)
-TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: cost-model estimate x2, 10 min to 24 h
-COST_CSV = paths.BENCH / "cost_growth.csv"
+TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: solver estimate x2, 10 min to 24 h
+ESTIMATE_KEYS = ("dof", "memory_mb", "seconds")         # the lines of `info --estimate` read here
 
 
 class EstimateError(Exception):
@@ -84,40 +83,23 @@ def case_of(run: str) -> str:
 
 
 def estimate(solver: pathlib.Path, preset: str, run: str, run_set: list[str]) -> dict:
-    """The solver's estimate of one run without building it: {'dof': int, 'memory_mb': int}."""
+    """The solver's estimate of one run without building it: {'dof': int, 'memory_mb': int, 'seconds': int}
+    (seconds: one core's wall time of the whole run, the twin's rate_factor included)."""
     cmd = [str(solver), "info", str(paths.case_file(case_of(run))), "--preset", preset,
            *run_sets(run, run_set), "--estimate"]
     try:
-        r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     except OSError as e:
         raise EstimateError(f"cannot run the solver {solver} ({e}): run `make build`")
     out = {}
     for line in r.stdout.splitlines():
         parts = line.split()
-        if len(parts) == 2 and parts[0] in ("dof", "memory_mb"):
+        if len(parts) == 2 and parts[0] in ESTIMATE_KEYS:
             out[parts[0]] = int(float(parts[1]))
-    if r.returncode != 0 or len(out) != 2:
-        why = (r.stderr.strip().splitlines() or ["no 'dof' and 'memory_mb' lines"])[0]
+    if r.returncode != 0 or len(out) != len(ESTIMATE_KEYS):
+        why = (r.stderr.strip().splitlines() or [f"not every line of {', '.join(ESTIMATE_KEYS)}"])[0]
         raise EstimateError(f"`{' '.join(cmd[1:])}`: {why}")
     return out
-
-
-def cost_rows(csv_path: pathlib.Path = COST_CSV) -> list[dict]:
-    """bench/cost_growth.csv rows of the lumped scheme at h_e = 0.3 d that carry a whole-run estimate."""
-    with open(csv_path) as f:
-        rows = [r for r in csv.DictReader(f) if r.get("integrator") == "lumped" and r.get("status") == "completed"
-                and r.get("est_steps_per_run_at_1e-3") and math.isclose(float(r["h_e"]), 0.3)]
-    if not rows:
-        fail(f"{csv_path} has no completed lumped row with est_steps_per_run_at_1e-3 (run `make bench`), "
-             "or give --time")
-    return rows
-
-
-def estimate_seconds(dof: int, slow: bool, rows: list[dict]) -> float:
-    """One core's wall time of a whole run: steps x DOF / (DOF-updates/s) at the nearest measured size."""
-    row = min(rows, key=lambda r: abs(math.log(float(r["dof"]) / dof)))
-    steps = float(row["est_steps_per_run_at_1e-3"]) * (2 if slow else 1)
-    return float(row["setup_s"]) * dof / float(row["dof"]) + steps * dof / float(row["dof_updates_per_s"])
 
 
 def slurm_time(seconds: float) -> str:
@@ -231,10 +213,9 @@ def main(argv=None) -> int:
         a.mem = f"{math.ceil((mb * MEM_FACTOR + MEM_EXTRA_MB) / 100) * 100}M"
         note.append(f"--mem {a.mem} (solver estimate {mb} MB, largest run)")
     if a.time is None:
-        rows = cost_rows()
-        s = max(estimate_seconds(e["dof"], r.endswith("_slow"), rows) for r, e in est.items())
+        s = max(e["seconds"] for e in est.values())
         a.time = slurm_time(min(TIME_MAX_S, max(TIME_MIN_S, TIME_FACTOR * s)))
-        note.append(f"--time {a.time} (cost model {s / 3600:.2g} h on one core, longest run)")
+        note.append(f"--time {a.time} (solver estimate {s / 3600:.2g} h on one core, longest run)")
 
     common = {"partition": a.partition, "account": a.account}
     common = {k: v for k, v in common.items() if v}

@@ -53,10 +53,15 @@ int checkMemory(const CaseParams& p) {
 
 int runInfo(const CaseArgs& args, bool estimateOnly) {
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
-  if (estimateOnly) {  // machine-readable, without building anything (cluster job scripts use it)
+  if (estimateOnly) {  // machine-readable, without building the model (cluster job scripts use it)
     const ResourceEstimate e = estimateResources(p);
     std::printf("nodes %.0f\ndof %.0f\ninterfaces %.0f\nmemory_mb %.0f\n", e.nodes, e.dof, e.interfaces,
                 std::ceil(e.memoryBytes / 1048576));
+    const StepScale s = stepScaleOfBlock(p);
+    const TimeEstimate t = estimateRunTime(p, s);
+    std::printf("c_d %.6g\ndt %.6g\nu_start %.6g\nu_end %.6g\nduration %.6g\nsteps %.0f\nseconds_per_step %.6g\n"
+                "setup_seconds %.0f\nseconds %.0f\n", s.c_d, s.dt, t.uStart, t.uEnd, t.duration, t.steps,
+                t.secondsPerStep, std::ceil(t.setupSeconds), std::ceil(t.seconds));
     return exit_code::ok;
   }
   if (int rc = checkMemory(p)) return rc;
@@ -219,8 +224,10 @@ int main(int argc, char** argv) {
   infoArgs.addTo(info);
   bool estimateOnly = false;
   info->add_flag("--estimate", estimateOnly,
-                 "print only the estimated counts and peak memory (lines 'nodes N', 'dof N', 'interfaces N', "
-                 "'memory_mb N'), without building the model");
+                 "print only the estimated counts, peak memory and one core's wall time of the whole run (lines "
+                 "'nodes N', 'dof N', 'interfaces N', 'memory_mb N', then 'c_d', 'dt', 'u_start', 'u_end', "
+                 "'duration', 'steps', 'seconds_per_step', 'setup_seconds', 'seconds'), without building the model "
+                 "(c_d and dt from a block of at most 16 x 8 d of the case)");
 
   CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5 (while it "
                                             "runs, and when interrupted: DIR/result.partial.h5; failed: "

@@ -1,7 +1,12 @@
 #include "resources.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+
+#include "setup.hpp"
+#include "simulation.hpp"
 
 namespace enamel {
 
@@ -36,6 +41,112 @@ ResourceEstimate estimateResources(const CaseParams& p) {
                                     : e.nodes * kLumpedBytesPerNode);
   if (p.static_start > 0) e.memoryBytes += e.nodes * (kStaticBytesPerNode + kStaticFillBytesPerNodeSliceNode * perSlice);
   return e;
+}
+
+namespace {
+// Time of a run (estimateRunTime). Measured with the build of commit c09beab on 2026-12-06, one thread, on this
+// project's development machine (AMD EPYC, AVX-512; 2 cores shared by several sessions, load 10-16: wall times
+// swing, so rates are CPU (user) seconds, and the constants take the slow side), with
+//   /usr/bin/time enamel-dem run paper_cases/CASE.toml --preset P --set threads=1 [--set max_steps=N ...]
+// and the run's /meta and /history.
+// Applied displacement at the stop, at delta0 = 0.1 d (in linear kinematics every displacement scales with delta0,
+// docs/model.md): U_end = U_i + k_a stop_da_over_d. U_i is where the crack starts to grow in the ci run of
+// theta30_s21.4_e10_cv0 (16 x 8 d: Delta_a > 0 at U = 2.50 d; U_end 5.08 d at Delta_a 5.13 d, 0.52 d per d after
+// it); k_a is that run's and the median of the 80 x 80 d runs of studies/square/data at the paper's rate (U_end
+// 10.4-24.8 d at Delta_a = 30 d, median 16.5 d: (16.5 - 2.5) / 30 = 0.47). Against runs: ci (5.0 d) 0.60x-1.24x
+// (U_end 4.04-8.39 d: theta0_s21.4_e10, theta15_s21.4_e5, theta30_s7.1/s21.4/s28.5_e10, cv 0), reduced 40 x 20 d
+// to 12 d (8.5 d) 1.00x (theta30_s21.4_e10_cv0: 8.49 d); 80 x 80 d (17.5 d) 0.71x (theta30_s28.5_e10_cv0, 24.8 d)
+// to 1.68x (theta0_s21.4_e10_cv0, 10.4 d); 100 x 100 d 1.0-1.2x (14.3-17.7 d); 200 x 200 d 1.26x (13.9 d). U_end
+// at a given stop does not grow with h_s beyond 80 d (16.5 d at 80 d, 13.9 d at 200 d), so h_s is not in it.
+constexpr double kUAtInitiation = 2.5;     // d
+constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
+// The static start's U_c (first damage, theta30_s21.4_e10_cv0): 0.272 d at h_s = 8 d, 0.529 at 20, 1.057 at 80
+// (the ci, reduced and converged presets' sizes), 1.705 at 200 (the paper preset, `make bench-paper`'s static
+// start, bench/experiments/step_rounds): k_c sqrt(h_s / d) with
+// k_c = 0.096-0.121; a low U_c skips less of the run, so k_c is on the low side of the larger sizes.
+constexpr double kUcPerSqrtHeight = 0.11;
+// Seconds per step. `lumped`: DOF-updates per second per core. Whole ci runs 52-93 M (the five cases above),
+// the whole reduced run 69 M, 2000 elastic steps at 80 x 80 d 109 M (user time less that of a 1-step run); on
+// the same machine kind unloaded `make bench` measured 127 M at 40 x 20 d (2026-12-06). 40 M allows for a
+// slower core, a larger specimen (fewer cache hits) and the fracture stage's interface law.
+constexpr double kLumpedDofUpdatesPerSecond = 40e6;
+// `paper` (consistent mass, CHOLMOD solve per step), per DOF: a + b x nodes of a slice (the factor's bandwidth);
+// measured 9.7e-8 s at 16 x 8 d (13.9 nodes a slice) and 1.22e-7 at 40 x 20 d (34.6), 3000 and 600 steps less
+// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench` (its cost growth as committed at c09beab). The
+// constants give 1.11x, 1.22x and 1.14x of these; at the paper preset's 346 nodes a slice, an extrapolation.
+constexpr double kPaperSecondsPerDof = 8e-8, kPaperSecondsPerDofSliceNode = 2e-9;
+// Set-up (the model, operators, integrator, c_d's block), per DOF: 1.8e-5 s user at 80 x 80 d (a 1-step run).
+// The static start's solve, per DOF and node of a slice: 82 s on 2 cores at 200 x 200 d (3.4e-7 core-s), 91 s
+// wall at 80 x 80 d under load (2.9e-6).
+constexpr double kSetupSecondsPerDof = 3e-5, kStaticSecondsPerDofSliceNode = 1e-6;
+constexpr double kBlockWidth = 16, kBlockHeight = 8;  // d: the block of stepScaleOfBlock (the ci preset's size)
+constexpr double kDefaultDelta0 = 0.1;                // d: the U_end and U_c measurements' delta0
+
+// Applied displacement at the stop, d: (U_i + k_a stop_da_over_d) (delta0 / 0.1 d), at most stop_u_over_d.
+double stopDisplacement(const CaseParams& p) {
+  const double atDefaultDelta0 = kUAtInitiation + kUPerCrackAdvance * p.stop_da_over_d;
+  return std::min(p.stop_u_over_d, atDefaultDelta0 * p.delta0_over_d / kDefaultDelta0);
+}
+
+// Applied displacement at the start, d: static_start x U_c, U_c = k_c (delta0 / 0.1 d) sqrt(h_s / d) (0 from rest).
+double startDisplacement(const CaseParams& p) {
+  return p.static_start * kUcPerSqrtHeight * p.delta0_over_d / kDefaultDelta0 * std::sqrt(p.h_s_over_d);
+}
+
+// One core's seconds per step: `lumped` a DOF-update rate; `paper` also the Cholesky solve, whose cost per DOF
+// grows with the nodes of a slice (the factor's bandwidth).
+double secondsPerStep(const CaseParams& p, const ResourceEstimate& e) {
+  if (p.integrator == "paper") return e.dof * (kPaperSecondsPerDof + kPaperSecondsPerDofSliceNode * e.nodes / e.slices);
+  return e.dof / kLumpedDofUpdatesPerSecond;
+}
+
+double setupSeconds(const CaseParams& p, const ResourceEstimate& e) {
+  const double staticSolve = p.static_start > 0 ? kStaticSecondsPerDofSliceNode * e.dof * e.nodes / e.slices : 0;
+  return kSetupSecondsPerDof * e.dof + staticSolve;
+}
+}  // namespace
+
+TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s) {
+  TimeEstimate t;
+  const ResourceEstimate e = estimateResources(p);
+  Loading loading;
+  loading.vApp = p.rate_factor * p.v_app_over_cd * s.c_d;
+  loading.rampTime = p.ramp_transits * p.h_s_over_d / s.c_d;
+  t.uEnd = stopDisplacement(p);
+  t.uStart = std::min(startDisplacement(p), t.uEnd);
+  t.duration = loading.timeOfDisplacement(t.uEnd) - loading.timeOfDisplacement(t.uStart);
+  t.steps = std::ceil(t.duration / s.dt);
+  if (p.max_steps > 0) t.steps = std::min(t.steps, static_cast<double>(p.max_steps));
+  t.secondsPerStep = secondsPerStep(p, e);
+  t.setupSeconds = setupSeconds(p, e);
+  t.seconds = t.setupSeconds + t.steps * t.secondsPerStep;
+  return t;
+}
+
+StepScale stepScaleOfBlock(const CaseParams& p) {
+  // the blocks are small unless h_e is: refuse one that cannot fit before building it (measureTransverseModulus's
+  // is at most 24 x 12 d)
+  CaseParams largest = p;
+  largest.w_s_over_d = std::min(p.w_s_over_d, 24.0);
+  largest.h_s_over_d = std::min(p.h_s_over_d, 12.0);
+  largest.static_start = 0;
+  const std::string why = checkMemoryFits(largest, availableMemoryBytes());
+  if (!why.empty()) throw std::invalid_argument("the blocks that measure c_d and dt: " + why);
+  StepScale s;
+  s.c_d = std::sqrt(p.E_transverse_over_Er > 0 ? p.E_transverse_over_Er : measureTransverseModulus(p));
+  CaseParams block = p;
+  // the model's h_e is w_s / round(w_s / h_e) (geometry.cpp): the block keeps the case's, so its rod elements are
+  // the case's (the same length, so the same element frequency)
+  const double h_e = p.w_s_over_d / std::round(p.w_s_over_d / p.h_e_over_d);
+  block.h_e_over_d = h_e;
+  block.w_s_over_d = h_e * std::max(2.0, std::round(std::min(p.w_s_over_d, kBlockWidth) / h_e));
+  block.h_s_over_d = std::min(p.h_s_over_d, kBlockHeight);
+  block.far_field_slices = 1;
+  block.static_start = 0;
+  block.E_transverse_over_Er = s.c_d * s.c_d;  // the case's c_d (the block's own would differ a little)
+  block.threads = 1;
+  s.dt = Simulation(block).integrator->timeStep();
+  return s;
 }
 
 double readProcKilobytes(const char* path, const char* key) {

@@ -17,6 +17,7 @@ equal to an uninterrupted run of the same case through the same Make rule (every
 result.h5 but the wall time, the peak memory and the write time); the figures job starts after both tasks have
 ended and draws Fig. 4 from their results.
 """
+import math
 import os
 import pathlib
 import pwd
@@ -296,7 +297,7 @@ def test_array_requeued_mid_run_resumes_bit_for_bit_then_figures(slurm, enamel, 
     array_script = (scripts / "runs.sbatch").read_text()
     assert "#SBATCH --array=0-1" in array_script and "#SBATCH --requeue" in array_script
     assert re.search(r"#SBATCH --mem=\d+M", array_script), "memory from the solver's estimate"
-    assert re.search(r"#SBATCH --time=\d+-\d\d:\d\d:00", array_script), "time from the cost model"
+    assert re.search(r"#SBATCH --time=\d+-\d\d:\d\d:00", array_script), "time from the solver's estimate"
 
     sub = subprocess.run(["bash", str(scripts / "submit.sh")], capture_output=True, text=True, env=slurm.env,
                          timeout=60)
@@ -398,3 +399,22 @@ def test_bad_input_is_one_line(enamel, tmp_path, args, message):
     lines = [line for line in r.stderr.splitlines() if not line.startswith("make: ***")]
     assert len(lines) == 1 and message in lines[0], r.stderr
     assert not (tmp_path / "ci" / "slurm").exists()
+
+
+def test_time_is_twice_the_solvers_estimate_of_the_longest_run(enamel, tmp_path):
+    """Without SLURM_TIME a task's time limit is 2x the longest run's `enamel-dem info --estimate` seconds (one
+    core, whole run), in whole minutes; the half-rate twin's estimate is made at its rate_factor (about 2x)."""
+    case = "theta30_s21.4_e10_cv0"
+    r = make_slurm(enamel, tmp_path, "PRESET=converged", f"CASES={case} {case}_slow")
+    assert r.returncode == 0, r.stderr
+    script = (tmp_path / "converged" / "slurm" / "runs.sbatch").read_text()
+    seconds = []
+    for sets in ([], ["--set", "rate_factor=0.5"]):
+        est = subprocess.run([str(enamel), "info", str(ROOT / "paper_cases" / f"{case}.toml"), "--preset", "converged",
+                              *sets, "--estimate"], capture_output=True, text=True, timeout=300)
+        assert est.returncode == 0, est.stderr
+        seconds.append(float(re.search(r"^seconds (\S+)$", est.stdout, re.M).group(1)))
+    assert 1.8 < seconds[1] / seconds[0] <= 2.0, seconds
+    minutes = math.ceil(min(86400, max(600, 2 * max(seconds))) / 60)
+    assert f"#SBATCH --time={minutes // 1440}-{minutes // 60 % 24:02d}:{minutes % 60:02d}:00\n" in script, script
+    assert "bench" not in script
