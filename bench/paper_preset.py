@@ -29,6 +29,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import bench  # noqa: E402
 from bench import run_bench  # noqa: E402
 from bench import records  # noqa: E402
 from enamel_results import paper_values, paths, results  # noqa: E402
@@ -42,8 +43,8 @@ CASE = run_bench.CASES[0]
 VARIANT = "lumped cap0.5 dt0.22 static"
 PRESET = "paper"
 EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests)
-RUNS = paths.BENCH_PAPER_PRESET    # --runs
-OUT = paths.BENCH                  # --out: paper_preset.md and out/paper_preset.{pdf,png}
+RUNS = bench.PAPER_PRESET_RUNS    # --runs
+OUT = bench.HERE                  # --out: paper_preset.md and out/paper_preset.{pdf,png}
 
 
 def run_dir() -> pathlib.Path:
@@ -107,7 +108,7 @@ def run(threads: int, checkpoint_every: float) -> int:
 def bench_row(variant: str) -> dict:
     """The bench's row for this case and variant (bench/results.csv), or {}."""
     try:
-        rows = run_bench.read_csv(paths.BENCH / "results.csv")
+        rows = run_bench.read_csv(bench.HERE / "results.csv")
     except OSError:
         return {}
     return next((r for r in rows if r["case"] == CASE and r["variant"] == variant), {})
@@ -117,7 +118,7 @@ def reduced_results() -> dict:
     """{label: Result} of this case at the `reduced` size from `make bench`'s runs, where they are."""
     out = {}
     for variant in (run_bench.REFERENCE, VARIANT):
-        p = run_bench.variant_dir(paths.BENCH_RUNS, CASE, variant) / "result.h5"
+        p = run_bench.variant_dir(bench.RUNS, CASE, variant) / "result.h5"
         try:
             out[f"reduced 40 d x 20 d, {variant}"] = results.load_result(p, case=CASE)
         except (results.MissingResult, OSError):
@@ -129,7 +130,7 @@ def cost_estimate_steps(r: results.Result) -> float:
     """The cost-growth table's step estimate for the paper-preset size at the paper rate, rescaled to this
     run's dt (the table's runs use the bench's dt_factor 0.1)."""
     try:
-        rows = run_bench.read_csv(paths.BENCH / "cost_growth.csv")
+        rows = run_bench.read_csv(bench.HERE / "cost_growth.csv")
     except OSError:
         return math.nan
     row = next((c for c in rows if c.get("integrator") == "lumped" and c.get("w_s") == r.param("w_s_over_d")

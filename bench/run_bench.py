@@ -41,6 +41,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
+import bench  # noqa: E402
 from enamel_results import metrics, paths, results  # noqa: E402
 from bench import records  # noqa: E402
 from bench.records import history_end  # noqa: E402
@@ -479,10 +480,10 @@ def replot(out: pathlib.Path) -> int:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=2, help="cores to use: runs at a time (default 2)")
-    ap.add_argument("--out", type=pathlib.Path, default=paths.BENCH,
-                    help=f"where results.csv, cost_growth.csv, results.md and out/ go (default {paths.BENCH})")
-    ap.add_argument("--runs", type=pathlib.Path, default=paths.BENCH_RUNS,
-                    help=f"where the runs go (default {paths.BENCH_RUNS})")
+    ap.add_argument("--out", type=pathlib.Path, default=bench.HERE,
+                    help=f"where results.csv, cost_growth.csv, results.md and out/ go (default {bench.HERE})")
+    ap.add_argument("--runs", type=pathlib.Path, default=bench.RUNS,
+                    help=f"where the runs go (default {bench.RUNS})")
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
     ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")

@@ -32,6 +32,7 @@ import sys
 import tempfile
 
 from enamel_results import paths
+import bench
 from bench import records
 
 CASE = paths.case_file("theta30_s21.4_e10_cv0")
@@ -158,7 +159,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--binary", default=str(paths.SOLVER))
     ap.add_argument("--against", help="a second binary (e.g. an older commit's), counted the same way")
-    ap.add_argument("--out", type=pathlib.Path, default=paths.BENCH)
+    ap.add_argument("--out", type=pathlib.Path, default=bench.HERE)
     a = ap.parse_args(argv)
     first, sizes, wall = measure(a.binary)
     runs = [(git(a.binary), first)]

@@ -6,9 +6,6 @@ PAPER_CASES = ROOT / "paper_cases"
 PAPER_VALUES = ROOT / "figures" / "paper_values.toml"
 RUNS = ROOT / "runs"
 FIGURES_OUT = ROOT / "figures" / "out"
-BENCH = ROOT / "bench"                  # make bench: results.csv, cost_growth.csv, results.md (committed), out/
-BENCH_RUNS = RUNS / "bench"             # ... and its runs
-BENCH_PAPER_PRESET = BENCH_RUNS / "paper_preset"  # make bench-paper: the one paper-preset case
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
 
 # The result files of a run directory, by status (solver/lib/output.cpp resultFileFor): result.h5 exists only for a

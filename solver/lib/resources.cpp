@@ -52,7 +52,7 @@ namespace {
 // Applied displacement at the stop, at delta0 = 0.1 d (in linear kinematics every displacement scales with delta0,
 // docs/model.md): U_end = U_i + k_a stop_da_over_d. U_i is where the crack starts to grow in the ci run of
 // theta30_s21.4_e10_cv0 (16 x 8 d: Delta_a > 0 at U = 2.50 d; U_end 5.08 d at Delta_a 5.13 d, 0.52 d per d after
-// it); k_a is that run's and the median of the 80 x 80 d runs of studies/square/data at the paper's rate (U_end
+// it); k_a is that run's and the median of the 80 x 80 d square runs of 2026-12-03/04 at the paper's rate (U_end
 // 10.4-24.8 d at Delta_a = 30 d, median 16.5 d: (16.5 - 2.5) / 30 = 0.47). Against runs: ci (5.0 d) 0.60x-1.24x
 // (U_end 4.04-8.39 d: theta0_s21.4_e10, theta15_s21.4_e5, theta30_s7.1/s21.4/s28.5_e10, cv 0), reduced 40 x 20 d
 // to 12 d (8.5 d) 1.00x (theta30_s21.4_e10_cv0: 8.49 d); 80 x 80 d (17.5 d) 0.71x (theta30_s28.5_e10_cv0, 24.8 d)
