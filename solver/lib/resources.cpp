@@ -62,7 +62,7 @@ constexpr double kUAtInitiation = 2.5;     // d
 constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
 // The static start's U_c (first damage, theta30_s21.4_e10_cv0): 0.272 d at h_s = 8 d, 0.529 at 20, 1.057 at 80
 // (the ci, reduced and converged presets' sizes), 1.705 at 200 (the paper preset, `make bench-paper`'s static
-// start, bench/experiments/step_rounds): k_c sqrt(h_s / d) with
+// start, 2026-12-05): k_c sqrt(h_s / d) with
 // k_c = 0.096-0.121; a low U_c skips less of the run, so k_c is on the low side of the larger sizes.
 constexpr double kUcPerSqrtHeight = 0.11;
 // Seconds per step. `lumped`: DOF-updates per second per core. Whole ci runs 52-93 M (the five cases above),
