@@ -233,7 +233,8 @@ class RunLoop {
     // Progress rates are measured over this piece of the run, and the crack's from where it started.
     marks_.piece = marks_.crackStart = marks_.lastAdvance = sample();
     for (const Measurement& r : rec_.history)  // the restart's rows: their largest ratio (not in the checkpoint)
-      if (pastElasticStart(r)) rec_.maxKineticRatioInelastic = std::max(rec_.maxKineticRatioInelastic, kineticOverStrain(r));
+      if (pastElasticStart(r))
+        rec_.maxKineticRatioInelastic = std::max(rec_.maxKineticRatioInelastic, kineticOverStrain(r));
   }
 
   /// The static elastic start (case key static_start), timed, and a line on stderr saying what it did.
