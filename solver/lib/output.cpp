@@ -235,7 +235,7 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "warnings", warnings);
   attr(g.id, "wall_time_s", rec.wallSeconds);
   attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
-  attr(g.id, "max_kinetic_over_strain_inelastic", rec.maxKineticRatioInelastic);  // the quasi-static warning's
+  attr(g.id, "max_quasi_static_ratio", rec.maxQuasiStaticRatio);  // the quasi-static warning's (runner.hpp)
   attr(g.id, "steps", rec.steps);
   attr(g.id, "dof", static_cast<long>(sim.model.numDofs()));
   attr(g.id, "threads", static_cast<long>(threadCount()));

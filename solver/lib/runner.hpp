@@ -76,9 +76,17 @@ std::string formatTimeLeft(const TimeLeft& t);
 double kineticOverStrain(const Measurement& r);
 
 /// Whether a history row is past the elastic start of the run: an interface past delta0, a rod element broken or
-/// the crack advanced. From then on the quasi-static warning watches kinetic / strain energy, whatever the crack
-/// does; before it the ratio only says how far the load has come.
+/// the crack advanced. From then on the quasi-static warning watches the row, whatever the crack does.
 bool pastElasticStart(const Measurement& r);
+
+/// The quasi-static warning's ratio of a history row (warned above 0.05): the larger of kinetic / strain energy
+/// while the crack grows (the warning's only measure before 2026-12-06) and, from the elastic start on, the
+/// kinetic energy beyond the loading's own motion / strain energy (Measurement::kineticBeyond). Proportional
+/// loading at a steady rate moves the nodes without accelerating them: its kinetic energy grows as the rate
+/// squared and says nothing about inertia (kinetic / strain up to 0.23 before the crack grows in a ci run whose
+/// adaptive rate reaches x8, at most 0.008 beyond the loading's motion; up to 1.7 beyond it at rate_factor = 500).
+/// 0 before the elastic start.
+double quasiStaticRatio(const Measurement& r);
 
 /// The exit status (exit_codes.hpp) for an error that ended a command: a bad case (its CaseError's code), a
 /// checkpoint of another build or case 13, a damaged one 14, a full disk 15, a file that cannot be written 8, a

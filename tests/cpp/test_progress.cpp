@@ -109,6 +109,20 @@ TEST(QuasiStatic, TheRatioIsWatchedFromTheElasticStartWhateverTheCrackDoes) {
   EXPECT_DOUBLE_EQ(enamel::kineticOverStrain(enamel::Measurement{}), 0.0);  // no strain: no ratio
 }
 
+TEST(QuasiStatic, BeforeTheCrackGrowsOnlyTheMotionBeyondTheLoadingsCounts) {
+  enamel::Measurement r;
+  r.kinetic = 0.2;         // mostly the grips' steady motion: no inertia
+  r.kineticBeyond = 0.01;  // beyond it
+  r.strainBeams = 1;
+  EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.0);  // elastic
+  r.inelasticInterfaces = 2;
+  EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.01);
+  r.crackAdvance = 0.5;  // while the crack grows, kinetic / strain energy as before 2026-12-06, or more
+  EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.2);
+  r.kineticBeyond = 0.3;
+  EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.3);
+}
+
 TEST(EnergyBalance, TheErrorIsMeasuredAgainstTheWorkFloorUntilTheWorkExceedsIt) {
   const double floor = enamel::balanceWorkFloor(2.0, 1.5);
   EXPECT_DOUBLE_EQ(floor, 0.3);
