@@ -36,6 +36,7 @@ SHELL := /bin/bash
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CHECKPOINT_EVERY ?= 60
+LOCK_WAIT ?= 0
 RUN_SET ?=
 
 # Debian packages: the complete set needed to build, test and draw figures.
@@ -149,7 +150,9 @@ check-preset:
 # was stopped, result.failed.h5 when it failed), so whatever stops the pipeline (Ctrl-C, SIGTERM, SIGKILL of
 # make), the next `make` re-runs exactly the unfinished cases; --resume continues each from its checkpoint
 # (written every CHECKPOINT_EVERY s) when the case and the solver binary are unchanged, and from step 0
-# otherwise, saying which in the log (appended to, one piece after another).
+# otherwise, saying which in the log (appended to, one piece after another). The solver locks the run directory
+# (DIR/.lock) for the run's life: a second run into it is refused with exit 17, changing nothing, after waiting
+# up to LOCK_WAIT s for the holder to end (default 0; the SLURM jobs wait, docs/cluster.md).
 # RUN_SET="key=value ..." adds --set overrides to every run (sweeps, experiments, tests). Make does not track them,
 # so without RUNS= on the command line they get a runs folder of their own (RUNS above).
 RUN_SETS := $(foreach s,$(RUN_SET),--set $(s))
@@ -158,6 +161,7 @@ define run_case
 	@echo "run: $(@D)"
 	@echo "== $$(date '+%F %T') make: $(ENAMEL) run $< --preset $(PRESET) $(1) $(RUN_SETS)" >> $(@D)/log.txt
 	@$(ENAMEL) run $< --preset $(PRESET) --out $(@D) --force --resume --checkpoint-every $(CHECKPOINT_EVERY) \
+	  --lock-wait $(LOCK_WAIT) \
 	  $(1) $(RUN_SETS) 2>> $(@D)/log.txt \
 	  || { rc=$$?; tail -n 3 $(@D)/log.txt >&2; \
 	       echo "run: $(@D) stopped (exit $$rc); partial result in $(@D)/result.failed.h5 or result.partial.h5," \
@@ -210,7 +214,7 @@ figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 SLURM_DIR = $(RUNS)/$(PRESET)/slurm
 SLURM_CPUS ?= 1
 # passed on to the jobs' make when given on the command line
-SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY PYTHON
+SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY LOCK_WAIT PYTHON
 slurm_opt = $(if $(2),'--$(1)=$(subst ','\'',$(2))')
 slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 	$(PYTHON) -m pipeline.slurm_jobs --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \

@@ -17,6 +17,13 @@ requeues itself (`scontrol requeue`): its next start continues the run. A SIGTER
 `scontrol requeue`, preemption) also reaches the solver, which writes its checkpoint before SLURM's KillWait
 ends; a requeued task continues, a cancelled one continues when submitted again.
 
+One run per directory. The solver holds a lock on its run directory for the run's life (DIR/.lock, released by
+the kernel when the process ends, however it ends). A task that starts while another process still holds it (a
+solver of the task's earlier start that outlived its job on a hung node, a run started by hand) waits up to
+LOCK_WAIT_S for it (Make's LOCK_WAIT; --make-var LOCK_WAIT=... changes it), then is refused cleanly (exit
+status 17, nothing of the other run changed) and the task fails without requeueing: submit again once that run
+has ended.
+
 Resources (every task of an array gets the same), both from the solver's own estimates (`enamel-dem info
 --estimate`, which builds no model) over the runs: memory is the largest, x1.25 + 256 MB; time is the longest
 run's `seconds`, one core's wall time of the whole run (the steps from the run's loading, stop criterion and
@@ -35,6 +42,7 @@ import subprocess
 import sys
 
 from enamel_results import paths  # the one place that defines paths
+from enamel_results.constants import EXIT  # the solver's exit statuses
 from pipeline.make_rules import figure_set  # the one place that lists the runs
 
 
@@ -42,6 +50,9 @@ PROG = "slurm_jobs.py"
 MEM_FACTOR, MEM_EXTRA_MB = 1.25, 256     # memory request: solver estimate x1.25 + 256 MB (make, shell, HDF5)
 TIME_FACTOR, TIME_MIN_S, TIME_MAX_S = 2.0, 600, 86400   # time: solver estimate x2, 10 min to 24 h
 ESTIMATE_KEYS = ("dof", "memory_mb", "seconds")         # the lines of `info --estimate` read here
+# s a task waits for another process's lock on its run directory: SLURM's KillWait (30 s by default) and an
+# NFSv4 lease (90 s by default: the locks of a node that died), with a margin
+LOCK_WAIT_S = 300
 
 
 class EstimateError(Exception):
@@ -145,6 +156,8 @@ if [ $requeue = yes ] && [ $rc != 0 ]; then
   scontrol requeue "${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}" && exit 0
   say "scontrol requeue failed: submit again to continue from the checkpoint"
 fi
+[ $rc = {locked} ] && say "another live run holds the run directory (exit {locked}): nothing was changed and the" \
+                         "task is not requeued; submit again once that run has ended"
 say "make exited with status $rc"
 exit $rc
 """
@@ -197,7 +210,7 @@ def main(argv=None) -> int:
     out = (a.out or pathlib.Path(a.runs) / a.preset / "slurm").resolve()
     run_set = a.run_set.split()
     make_vars = [f"PRESET={a.preset}", f"RUNS={a.runs}", *([f"RUN_SET={a.run_set}"] if run_set else []),
-                 *a.make_var]
+                 f"LOCK_WAIT={LOCK_WAIT_S}", *a.make_var]   # a later --make-var LOCK_WAIT=... wins
     make = f"make --no-print-directory -o {shlex.quote(str(a.solver))} {quote_vars(make_vars)}"
 
     note = []
@@ -230,7 +243,7 @@ def main(argv=None) -> int:
     header = (f"#!/bin/bash\n# Written by pipeline/slurm_jobs.py: preset {a.preset}, {len(runs)} runs; "
               f"submit with {out / 'submit.sh'}\n")
     body = ARRAY_BODY.format(targets="".join(f"  {shlex.quote(t)}   # task {i}\n" for i, t in enumerate(targets)),
-                             make=make, signal_s=a.signal_seconds)
+                             make=make, signal_s=a.signal_seconds, locked=EXIT["output_locked"])
     out.mkdir(parents=True, exist_ok=True)
     logs.mkdir(exist_ok=True)
     (out / "runs.sbatch").write_text(header + sbatch_lines(array) + extra + body)

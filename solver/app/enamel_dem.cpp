@@ -10,10 +10,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "beam.hpp"
 #include "case_params.hpp"
 #include "exit_codes.hpp"
+#include "file_io.hpp"
 #include "geometry.hpp"
 #include "integrators.hpp"
 #include "profile.hpp"
@@ -113,6 +115,26 @@ int runProfile(const CaseArgs& args, long warmup, long steps) {
   return exit_code::ok;
 }
 
+// The output directory, created if needed and locked for this run's whole life (DirectoryLock), before anything
+// else is written to it: a second run into it is refused (or waits up to --lock-wait s) and changes nothing.
+int lockOutput(const std::string& dir, double waitSeconds, std::unique_ptr<DirectoryLock>& lock) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return fail(exit_code::output_unwritable, "cannot create output directory '" + dir + "': " + ec.message());
+  try {
+    lock = std::make_unique<DirectoryLock>(dir, 0.0);
+  } catch (const DirectoryLocked&) {
+    if (!(waitSeconds > 0)) throw;
+    std::fprintf(stderr, "enamel-dem: run directory '%s' is in use (%s): waiting up to %g s for it\n", dir.c_str(),
+                 directoryLockHolder(dir).c_str(), waitSeconds);
+    lock = std::make_unique<DirectoryLock>(dir, waitSeconds);
+  }
+  if (!lock->why().empty())
+    std::fprintf(stderr, "enamel-dem: warning: %s%s\n", lock->why().c_str(),
+                 lock->held() ? "" : ": running without the lock, a second run into this directory is not refused");
+  return exit_code::ok;
+}
+
 // Output directory: created if needed, must be writable, and must not hold a result unless --force.
 int prepareOutput(const std::string& dir, bool force, std::string& resultPath) {
   std::error_code ec;
@@ -142,6 +164,7 @@ struct RunFlags {
   std::string outDir;
   bool force = false, quiet = false, restart = false, resume = false;
   double checkpointEvery = -1;  // < 0: the case key checkpoint_interval_s
+  double lockWait = 0;          // s to wait for another run's lock on the output directory
 };
 
 int runRun(const CaseArgs& args, RunFlags flags) {
@@ -155,8 +178,10 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   if (flags.restart && !fs::exists(checkpointPath))
     return fail(exit_code::missing_file, "--restart: no checkpoint '" + checkpointPath +
                                              "' (a run writes one every checkpoint_interval_s and on SIGINT/SIGTERM)");
-  if (flags.restart) checkCheckpoint(checkpointPath, p);  // a bad one is refused before anything is changed
   if (int rc = checkMemory(p)) return rc;
+  std::unique_ptr<DirectoryLock> lock;  // held until the run returns: the kernel drops it if the process dies
+  if (int rc = lockOutput(outDir, flags.lockWait, lock)) return rc;
+  if (flags.restart) checkCheckpoint(checkpointPath, p);  // a bad one is refused before anything is changed
   bool restart = flags.restart;
   if (flags.resume) {  // continue when the checkpoint is this build's and this case's, else start over, saying why
     std::string why = "no checkpoint " + checkpointPath;
@@ -246,6 +271,10 @@ int main(int argc, char** argv) {
   run->add_option("--checkpoint-every", flags.checkpointEvery,
                   "write DIR/checkpoint.bin every this many wall-clock seconds (default: the case key "
                   "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--lock-wait", flags.lockWait,
+                  "while another live run holds DIR (its lock DIR/.lock), wait up to this many seconds for it to "
+                  "end (default 0: refused at once, exit status 17, nothing changed)")
       ->check(CLI::NonNegativeNumber);
 
   CaseArgs profileArgs;

@@ -21,5 +21,6 @@ constexpr int checkpoint_invalid = 13;  // --restart: the checkpoint is of anoth
 constexpr int checkpoint_damaged = 14;  // the checkpoint's checksum or structure is wrong: delete it to start over
 constexpr int disk_full = 15;           // a checkpoint or result file did not fit: no space left, quota, file size
 constexpr int result_damaged = 16;      // (Python readers) a result file is truncated or fails its checksum
+constexpr int output_locked = 17;       // another live run holds the output directory's lock (DIR/.lock): refused
 
 }  // namespace enamel::exit_code

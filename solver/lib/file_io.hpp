@@ -3,7 +3,8 @@
 // written. Both the checkpoint (checkpoint.cpp) and the result file (output.cpp) are built in memory and
 // written through writeFileAtomically: the bytes go to `path.tmp`, are flushed to the disk, and renamed over
 // `path`, so a run stopped or a disk filled at any moment leaves the previous complete file, and a failed write
-// removes its temporary file and says which file and how many bytes it needed.
+// removes its temporary file and says which file and how many bytes it needed. A run directory belongs to one
+// run at a time: DirectoryLock holds an exclusive lock on it for the run's whole life.
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -25,5 +26,37 @@ std::uint32_t crc32(const void* data, std::size_t n, std::uint32_t crc = 0);
 /// Write `bytes` to `path.tmp`, fsync it and rename it over `path`. On any failure the temporary file is
 /// removed, `path` is left as it was, and WriteError says "<what> '<path.tmp>' (<n> bytes): <reason>".
 void writeFileAtomically(const std::string& path, const std::string& bytes, const std::string& what);
+
+/// Another process holds a run directory's lock (DirectoryLock); the message names the directory and the
+/// holder's pid and host, as the holder wrote them into the lock file.
+struct DirectoryLocked : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// An exclusive lock on a run directory for as long as this object lives: flock(2) on DIR/.lock through an open
+/// descriptor, so the kernel drops it when the process ends, however it ends (a killed run leaves no stale
+/// lock). The lock file is created if needed and, once locked, holds "pid <pid> host <host> since <UTC time>".
+/// Waits up to waitSeconds for the holder to let go (0: not at all), then throws DirectoryLocked; WriteError
+/// when the lock file cannot be created. A file system without locks (flock fails with another error than
+/// EWOULDBLOCK) gives an unlocked object: held() is false and why() says why.
+class DirectoryLock {
+ public:
+  static constexpr const char* kFileName = ".lock";
+  DirectoryLock(const std::string& dir, double waitSeconds);
+  ~DirectoryLock();
+  DirectoryLock(const DirectoryLock&) = delete;
+  DirectoryLock& operator=(const DirectoryLock&) = delete;
+  bool held() const { return held_; }
+  const std::string& why() const { return why_; }
+
+ private:
+  int fd_ = -1;
+  bool held_ = false;
+  std::string why_;
+};
+
+/// Who holds the lock of `dir`, as its lock file says ("pid 123 host node7 since 2026-12-06T03:20:00Z"), or
+/// "" when the file is absent or empty.
+std::string directoryLockHolder(const std::string& dir);
 
 }  // namespace enamel

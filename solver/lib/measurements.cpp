@@ -213,4 +213,11 @@ double computeGripLoad(const Operators& ops, const State& s) {
   return P;
 }
 
+double balanceWorkFloor(double Gamma, double B) { return 0.1 * Gamma * B; }
+
+double energyBalanceError(double external, double storedKineticDissipated, double workFloor) {
+  const double scale = std::max(std::abs(external), workFloor);
+  return scale > 0 ? (external - storedKineticDissipated) / scale : 0.0;
+}
+
 }  // namespace enamel

@@ -49,4 +49,14 @@ double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State
 /// The generalised force conjugate to U: sum of F_y x shape over the prescribed DOFs.
 double computeGripLoad(const Operators& ops, const State& s);
 
+/// The work floor of the energy balance error: 0.1 Gamma_i B d, the work to open a tenth of one d of crack
+/// across the z-period B. Until the external work exceeds it, the error is measured against it.
+double balanceWorkFloor(double Gamma, double B);
+
+/// The energy balance error of a history row (/history/energy_balance_error, docs/solver.md): (external work -
+/// stored - kinetic - dissipated) / max(|external work|, workFloor). Against the floor, the first rows of a run
+/// (external work ~1e-10 of it) do not turn the round-off and the time discretisation of the work into errors of
+/// order one; once the work exceeds the floor it is the relative error of the balance.
+double energyBalanceError(double external, double storedKineticDissipated, double workFloor);
+
 }  // namespace enamel

@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "kernels.hpp"
+#include "measurements.hpp"
 #include "resources.hpp"
 #include "strength.hpp"
 #include "file_io.hpp"
@@ -71,7 +72,10 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"fracture_energy_rods", &M::rodFracture, eu},
       {"external_work", &M::external, eu},
       {"energy_balance_error", &M::balanceError, "-",
-       "(external work - stored - kinetic - dissipated) / external work"},
+       "(external work - stored - kinetic - dissipated) / max(|external work|, work_floor), work_floor = 0.1 "
+       "Gamma_i B d (this dataset's attribute work_floor, in E_r d^3): meaningful from the first row, where the "
+       "work is ~1e-10 of the floor; the relative error of the balance once the work exceeds the floor "
+       "(before 2026-12-06: divided by the external work alone)"},
       {"broken_rod_elements", &M::brokenBeams, "count"},
       {"failed_interfaces", &M::failedInterfaces, "count"},
       {"inelastic_interfaces", &M::inelasticInterfaces, "count"},
@@ -231,6 +235,7 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "warnings", warnings);
   attr(g.id, "wall_time_s", rec.wallSeconds);
   attr(g.id, "max_kinetic_over_strain_while_growing", rec.maxKineticRatio);
+  attr(g.id, "max_quasi_static_ratio", rec.maxQuasiStaticRatio);  // the quasi-static warning's (runner.hpp)
   attr(g.id, "steps", rec.steps);
   attr(g.id, "dof", static_cast<long>(sim.model.numDofs()));
   attr(g.id, "threads", static_cast<long>(threadCount()));
@@ -383,6 +388,8 @@ std::string buildImage(const std::string& path, const Simulation& sim, const Run
     {
       Handle g(H5Gcreate2(file.id, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "/history");
       for (const HistoryColumn& c : historyColumns()) historyDataset(g.id, c, rec.history, sim.params.Gamma());
+      Handle balance(H5Dopen2(g.id, "energy_balance_error", H5P_DEFAULT), H5Dclose, "/history/energy_balance_error");
+      attr(balance.id, "work_floor", balanceWorkFloor(sim.params.Gamma(), sim.model.B));
     }
     writeGeometry(file.id, sim);
     writeFrames(file.id, rec);

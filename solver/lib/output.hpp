@@ -36,6 +36,8 @@ struct RunRecord {
   long steps = 0;
   std::vector<std::string> warnings;      // quasi-static checks that left their bounds
   double maxKineticRatio = 0;             // largest kinetic / strain energy while the crack grew
+  double maxQuasiStaticRatio = 0;         // largest runner.hpp quasiStaticRatio (the warning's); not in the
+                                          // checkpoint: a restart recomputes it from the history
   bool warnedBalance = false, warnedKinetic = false, warnedEdge = false;  // each warning is recorded once
   bool warnedFarFieldRod = false;
   StaticStart staticStart;                // what the static elastic start did (fraction 0: from rest)

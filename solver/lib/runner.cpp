@@ -16,6 +16,7 @@
 #include "exit_codes.hpp"
 #include "file_io.hpp"
 #include "loading_rate.hpp"
+#include "measurements.hpp"
 
 namespace enamel {
 
@@ -27,7 +28,6 @@ volatile std::sig_atomic_t gStopSignal = 0;
 constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
 constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
 constexpr double kEdgeWarnDistance = 2.0;  // d: the inelastic zone this near the loaded edges: warning
-constexpr double kBalanceMinWork = 0.1;    // x Gamma_i B d: the balance error is checked once this much work was done
 
 std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0, double e = 0) {
   char buf[256];
@@ -47,18 +47,54 @@ std::string formatDuration(double seconds) {
 }
 }  // namespace
 
-double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop) {
-  const double elapsed = now.wall - since.wall;
-  double left = NAN;
-  auto aim = [&](double from, double at, double target) {
-    if (target <= 0 || !(at > from)) return;
-    const double t = std::max(0.0, elapsed * (target - at) / (at - from));
-    left = std::isnan(left) ? t : std::min(left, t);
+TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop) {
+  // Seconds to `target` at the rate the quantity went from `from` to `at` since the wall time `since`; NaN when
+  // the criterion is absent or the quantity has not progressed.
+  auto aim = [&](double since, double from, double at, double target) {
+    if (target <= 0 || !(at > from) || !(now.wall > since)) return double(NAN);
+    return std::max(0.0, (now.wall - since) * (target - at) / (at - from));
   };
-  aim(since.step, now.step, stop.steps);
-  aim(since.crackAdvance, now.crackAdvance, stop.crackAdvance);
-  if (now.crackAdvance > 0) aim(since.displacement, now.displacement, stop.displacement);
-  return left;
+  TimeLeft best;
+  auto consider = [&](double seconds, TimeLeft::Basis basis) {
+    if (std::isnan(seconds) || (!std::isnan(best.seconds) && !(seconds < best.seconds))) return;
+    best.seconds = seconds;
+    best.basis = basis;
+  };
+  const ProgressSample& p = marks.piece;
+  consider(aim(p.wall, p.step, now.step, stop.steps), TimeLeft::Basis::steps);
+  consider(aim(p.wall, p.displacement, now.displacement, stop.displacement), TimeLeft::Basis::displacement);
+  const ProgressSample& c = marks.crackStart;
+  const double crack = aim(c.wall, c.crackAdvance, now.crackAdvance, stop.crackAdvance);
+  if (!std::isnan(crack)) {
+    best.stalled = now.wall - marks.lastAdvance.wall > crack;
+    if (!best.stalled) consider(crack, TimeLeft::Basis::crack);
+  }
+  return best;
+}
+
+std::string formatTimeLeft(const TimeLeft& t) {
+  using B = TimeLeft::Basis;
+  const std::string prefix = t.stalled ? "crack stalled, " : "";
+  if (t.basis == B::none || std::isnan(t.seconds)) return t.stalled ? "crack stalled" : "?";
+  const std::string d = formatDuration(t.seconds);
+  if (t.basis == B::crack) return prefix + d;
+  return prefix + "<= " + d + (t.basis == B::displacement ? " (U limit)" : " (max_steps)");
+}
+
+double kineticOverStrain(const Measurement& r) {
+  const double strain = r.strainBeams + r.strainInterfaces;
+  return strain > 0 ? r.kinetic / strain : 0.0;
+}
+
+bool pastElasticStart(const Measurement& r) {
+  return r.inelasticInterfaces > 0 || r.brokenBeams > 0 || r.crackAdvance > 0;
+}
+
+double quasiStaticRatio(const Measurement& r) {
+  if (!pastElasticStart(r)) return 0.0;
+  const double strain = r.strainBeams + r.strainInterfaces;
+  const double beyond = strain > 0 ? r.kineticBeyond / strain : 0.0;
+  return std::max(beyond, r.crackAdvance > 0 ? kineticOverStrain(r) : 0.0);
 }
 
 void requestStop(int signal) { gStopSignal = signal; }
@@ -128,7 +164,7 @@ void installStopHandlers() {
 GuardBounds guardBounds(double Gamma, double B) {
   GuardBounds b;
   b.Gamma = Gamma;
-  b.minWork = kBalanceMinWork * Gamma * B;
+  b.minWork = balanceWorkFloor(Gamma, B);
   b.negativeJ = 1e-6 * Gamma;
   return b;
 }
@@ -142,7 +178,7 @@ std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBo
       return fmt("non-finite state at step %.0f (t = %g): J = %g, kinetic = %g, external work = %g; "
                  "the time step or the loading is unstable", double(r.step), r.time, r.J, r.kinetic, r.external);
   const double stored = r.kinetic + r.strainBeams + r.strainInterfaces + r.damping + r.fracture + r.rodFracture;
-  const double balance = std::abs(r.external - stored) / std::max(std::abs(r.external), b.minWork);
+  const double balance = std::abs(energyBalanceError(r.external, stored, b.minWork));
   if (balance > b.balance)
     return fmt("energy balance error %.3g at step %.0f exceeds the bound %.2g (external work %.4g, stored, kinetic "
                "and dissipated %.4g): energy is created or lost; reduce dt_factor or the loading rate",
@@ -158,6 +194,7 @@ int exitCodeOf(const std::exception& e) {
   if (const auto* c = dynamic_cast<const CaseError*>(&e)) return c->exitCode;
   if (dynamic_cast<const CheckpointDamaged*>(&e)) return exit_code::checkpoint_damaged;
   if (dynamic_cast<const CheckpointError*>(&e)) return exit_code::checkpoint_invalid;
+  if (dynamic_cast<const DirectoryLocked*>(&e)) return exit_code::output_locked;
   if (const auto* w = dynamic_cast<const WriteError*>(&e))
     return w->diskFull ? exit_code::disk_full : exit_code::output_unwritable;
   if (dynamic_cast<const IntegratorError*>(&e) || dynamic_cast<const std::invalid_argument*>(&e))
@@ -201,7 +238,9 @@ class RunLoop {
     }
     save();
     // Progress rates are measured over this piece of the run, and the crack's from where it started.
-    pieceStart_ = etaSince_ = sample();
+    marks_.piece = marks_.crackStart = marks_.lastAdvance = sample();
+    for (const Measurement& r : rec_.history)  // the restart's rows: their largest ratio (not in the checkpoint)
+      rec_.maxQuasiStaticRatio = std::max(rec_.maxQuasiStaticRatio, quasiStaticRatio(r));
   }
 
   /// The static elastic start (case key static_start), timed, and a line on stderr saying what it did.
@@ -230,9 +269,10 @@ class RunLoop {
     const State& s = sim_.state;
     if (!(s.crackAdvance > lastDa_)) return true;
     if (lastDa_ == 0) {  // the crack starts: its rate is measured from here, its first advance included
-      etaSince_ = sample();
-      etaSince_.crackAdvance = 0;
+      marks_.crackStart = sample();
+      marks_.crackStart.crackAdvance = 0;
     }
+    marks_.lastAdvance = sample();
     lastDa_ = s.crackAdvance;
     rec_.rcurveDa.push_back(s.crackAdvance);
     const double J = sim_.computeJ();
@@ -245,11 +285,8 @@ class RunLoop {
                 (std::isfinite(J) ? "negative beyond round-off" : "not finite") + ": the state is unsound");
   }
 
-  /// Kinetic / strain energy while the crack grows (before it, the ratio only says how far the load has come).
-  double kineticRatioOf(const Measurement& r) const {
-    const double strain = r.strainBeams + r.strainInterfaces;
-    return sim_.state.crackAdvance > 0 && strain > 0 ? r.kinetic / strain : 0.0;
-  }
+  /// Kinetic / strain energy while the crack grows: the blow-up guard's ratio (its bound was measured so).
+  static double kineticRatioOf(const Measurement& r) { return r.crackAdvance > 0 ? kineticOverStrain(r) : 0.0; }
 
   bool historyDue() const { return sim_.state.step % historyEvery_ == 0; }
 
@@ -265,17 +302,13 @@ class RunLoop {
     const double kineticRatio = kineticRatioOf(r);
     const std::string blowUp = blowUpCheck(r, kineticRatio, guard_);
     if (!blowUp.empty()) return fail(blowUp);
-    if (!rec_.warnedBalance && r.external > guard_.minWork && std::abs(r.balanceError) > kBalanceWarn) {
+    if (!rec_.warnedBalance && std::abs(r.balanceError) > kBalanceWarn) {  // against the work floor: any row
       rec_.warnedBalance = true;
       rec_.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
                                   kBalanceWarn));
     }
     rec_.maxKineticRatio = std::max(rec_.maxKineticRatio, kineticRatio);
-    if (!rec_.warnedKinetic && kineticRatio > kKineticWarn) {
-      rec_.warnedKinetic = true;
-      rec_.warnings.push_back(fmt("kinetic / strain energy %.3g at step %.0f above %.2g: not quasi-static",
-                                  kineticRatio, s.step, kKineticWarn));
-    }
+    warnIfNotQuasiStatic(r);
     // A reduced far field holds only while the inelastic zone stays inside the full band: its lumped interfaces
     // cannot soften apart, and its rod elements stand for m slices each (far_field_rod_breaks = allow lets
     // them break whole, with a warning; interfaces past delta0 there always stop the run).
@@ -313,6 +346,22 @@ class RunLoop {
     return true;
   }
 
+  /// The quasi-static warning, once: quasiStaticRatio above kKineticWarn at any row past the elastic start, whether
+  /// the crack grows or not (rods breaking ahead of a crack that stands count too).
+  void warnIfNotQuasiStatic(const Measurement& r) {
+    const double ratio = quasiStaticRatio(r);
+    rec_.maxQuasiStaticRatio = std::max(rec_.maxQuasiStaticRatio, ratio);
+    if (rec_.warnedKinetic || !(ratio > kKineticWarn)) return;
+    rec_.warnedKinetic = true;
+    const bool growth = r.crackAdvance > 0 && kineticOverStrain(r) >= ratio;  // which measure gave the ratio
+    rec_.warnings.push_back(std::string(growth ? "kinetic / strain energy" : "kinetic energy beyond the loading's "
+                                                                             "motion / strain energy") +
+                            fmt(" %.3g at step %.0f above %.2g: not quasi-static (Delta_a %.3g d, ", ratio,
+                                double(r.step), kKineticWarn, r.crackAdvance) +
+                            fmt("%.0f rod elements broken, %.0f interfaces past delta0)", r.brokenBeams,
+                                r.inelasticInterfaces));
+  }
+
   /// The adaptive loading rate (loading_rate.hpp), at each history row when rate_adapt_max > 1: the rule
   /// nextRateMultiplier on the interval since the previous row (energies at its end, rods deleted and interfaces
   /// failed during it) sets phi's next target, reached linearly over the next history interval.
@@ -338,11 +387,12 @@ class RunLoop {
     lastProgress_ = w;
     const State& s = sim_.state;
     const ProgressSample now = sample();
-    const double eta = estimateSecondsLeft(etaSince_, now, stopTargets_);
-    const double rate = now.wall > pieceStart_.wall ? (now.step - pieceStart_.step) / (now.wall - pieceStart_.wall) : 0;
+    const std::string eta = formatTimeLeft(estimateTimeLeft(marks_, now, stopTargets_));
+    const ProgressSample& piece = marks_.piece;
+    const double rate = now.wall > piece.wall ? (now.step - piece.step) / (now.wall - piece.wall) : 0;
     std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  rate x%.3g  %.1f steps/s  ETA %s%s",
                  tty_ ? "\r" : "", s.step, s.time, now.displacement, s.crackAdvance, r.J / p_.Gamma(),
-                 s.brokenBeams(), s.rateMultiplier, rate, std::isfinite(eta) ? formatDuration(eta).c_str() : "?",
+                 s.brokenBeams(), s.rateMultiplier, rate, eta.c_str(),
                  tty_ ? "   " : "\n");
   }
 
@@ -437,7 +487,7 @@ class RunLoop {
   double wallBefore_ = 0;  // wall time of the run before a restart
   double lastWrite_ = 0, lastProgress_ = 0, lastCheckpoint_ = 0, lastDa_ = 0;
   std::size_t nextFrame_ = 0;
-  ProgressSample pieceStart_, etaSince_;
+  ProgressMarks marks_;  // where the progress line's rates are measured from
 };
 
 }  // namespace

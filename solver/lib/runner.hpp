@@ -44,15 +44,53 @@ struct StopTargets {
   double steps = 0;         // max_steps
 };
 
-/// Seconds left to the nearest stop criterion, each extrapolated at the rate it progressed from `since` to
-/// `now` (pass the sample where this piece of the run, or the crack, started: the time to initiation says
-/// nothing about the crack's speed). The crack-advance criterion counts only once the crack has moved since
-/// `since`. NaN when no criterion has progressed: before the crack starts only max_steps gives an estimate,
-/// since the displacement limit is usually a far safety net.
-double estimateSecondsLeft(const ProgressSample& since, const ProgressSample& now, const StopTargets& stop);
+/// Where the rates of the estimate are measured from: this piece of the run, the crack's start in it, and the
+/// crack's last advance.
+struct ProgressMarks {
+  ProgressSample piece;        // where this piece of the run started (the run's start or its restart)
+  ProgressSample crackStart;   // where the crack started moving in this piece (at a restart: where it stood)
+  ProgressSample lastAdvance;  // where the crack last advanced (the piece's start until it does)
+};
+
+/// The estimate of the time left and what it rests on.
+struct TimeLeft {
+  enum class Basis { none, steps, crack, displacement };
+  double seconds = NAN;       // NaN: no criterion has progressed
+  Basis basis = Basis::none;  // the criterion expected first
+  bool stalled = false;       // the crack has stood still for longer than its own rate gave for the rest
+};
+
+/// Seconds left to the nearest stop criterion, each extrapolated at the rate it progressed: the steps and the
+/// applied displacement since the piece started, the crack advance since the crack started (the time to
+/// initiation says nothing about the crack's speed), once it has moved in this piece. Before the crack moves the
+/// loading gives the estimate (the displacement limit, or max_steps): an upper bound, as the crack usually stops
+/// the run sooner. A crack whose silence since its last advance exceeds what its average rate gave for the rest
+/// is `stalled`, and the loading gives the estimate again. A pure function of the samples.
+TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop);
+
+/// The progress line's ETA: "12 min" (the crack's), "<= 2 h 05 min (U limit)" or "<= 40 s (max_steps)" (the
+/// loading's: an upper bound), "crack stalled, <= ..." and "?" (no estimate yet).
+std::string formatTimeLeft(const TimeLeft& t);
+
+/// kinetic / strain energy of a history row (0 without strain energy).
+double kineticOverStrain(const Measurement& r);
+
+/// Whether a history row is past the elastic start of the run: an interface past delta0, a rod element broken or
+/// the crack advanced. From then on the quasi-static warning watches the row, whatever the crack does.
+bool pastElasticStart(const Measurement& r);
+
+/// The quasi-static warning's ratio of a history row (warned above 0.05): the larger of kinetic / strain energy
+/// while the crack grows (the warning's only measure before 2026-12-06) and, from the elastic start on, the
+/// kinetic energy beyond the loading's own motion / strain energy (Measurement::kineticBeyond). Proportional
+/// loading at a steady rate moves the nodes without accelerating them: its kinetic energy grows as the rate
+/// squared and says nothing about inertia (kinetic / strain up to 0.23 before the crack grows in a ci run whose
+/// adaptive rate reaches x8, at most 0.008 beyond the loading's motion; up to 1.7 beyond it at rate_factor = 500).
+/// 0 before the elastic start.
+double quasiStaticRatio(const Measurement& r);
 
 /// The exit status (exit_codes.hpp) for an error that ended a command: a bad case (its CaseError's code), a
 /// checkpoint of another build or case 13, a damaged one 14, a full disk 15, a file that cannot be written 8, a
+/// run directory another run holds 17, a
 /// case the integrator refuses or a value out of range 7, anything else (a factorisation that failed) 11.
 int exitCodeOf(const std::exception& e);
 
@@ -62,7 +100,7 @@ struct GuardBounds {
   /// |external work - (stored + kinetic + dissipated)| / max(|external work|, minWork): checked at every row,
   /// whatever the sign of the external work (a state whose work runs negative is not exempt).
   double balance = 0.25;
-  double minWork = 0;     // 0.1 Gamma_i B d: below this much work the error is measured against it
+  double minWork = 0;     // balanceWorkFloor, 0.1 Gamma_i B d: below this much work the error is measured against it
   /// kinetic / strain energy while the crack grows (0.05 is the quasi-static warning). Ten times the largest
   /// ratio of any completed run measured by 2026-12-03: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
   /// 0.299 at 80 x 80 d with the reduced far field, 0.156 at 100 x 100 d: docs/solver.md), so 3.2.
@@ -79,8 +117,8 @@ GuardBounds guardBounds(double Gamma, double B);
 bool resistanceIsPhysical(double J, const GuardBounds& b);
 
 /// Why a history row shows a run that blew up, in one sentence naming the check, the step and the values; ""
-/// when it passes: a non-finite energy or J, the energy balance, kinetic / strain energy (`kineticRatio`, 0
-/// before the crack grows). A pure function of the row.
+/// when it passes: a non-finite energy or J, the energy balance (energyBalanceError against b.minWork), kinetic /
+/// strain energy (`kineticRatio`, 0 before the crack grows). A pure function of the row.
 std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBounds& b);
 
 /// Ask a running simulation to stop at the next step (signal handlers call this).

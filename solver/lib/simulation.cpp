@@ -192,7 +192,7 @@ Measurement Simulation::measure() const {
   r.rodFracture = state.rodFractureEnergy;
   r.external = state.externalWork;
   const double stored = r.kinetic + r.strainBeams + r.strainInterfaces + r.damping + r.fracture + r.rodFracture;
-  r.balanceError = r.external > 0 ? (r.external - stored) / r.external : 0.0;
+  r.balanceError = energyBalanceError(r.external, stored, balanceWorkFloor(params.Gamma(), model.B));
   r.brokenBeams = state.brokenBeams();
   r.failedInterfaces = countFailedInterfaces();
   r.inelasticInterfaces = countInelasticInterfaces();
