@@ -43,3 +43,40 @@ def test_a_long_function_is_caught(tmp_path):
                    "}  // namespace enamel\n")
     found = check_function_length.long_functions(src, 80)
     assert [(name, n) for _, name, n in found] == [("longOne", 88)]
+
+
+def test_a_long_method_in_a_class_body_is_caught_and_a_short_one_is_not(tmp_path):
+    # Methods are measured where they stand: inside class and struct bodies (nested ones too), inline in a
+    # header, after access specifiers, attributes and a constructor's braced initialisers; an enum, a braced
+    # table and a local struct are not functions of their own.
+    body = "\n".join(f"    x += {i};" for i in range(85))
+    table = ",\n".join(f"  {i}" for i in range(90))
+    src = tmp_path / "scheme.hpp"
+    src.write_text(
+        "#pragma once\n#define CLONES [[gnu::target_clones(\"arch=x86-64-v3\", \"default\")]]\n"
+        "namespace enamel {\n"
+        f"inline constexpr int kTable[] = {{\n{table}\n}};\n"
+        "enum class Kind : int {\n" + ",\n".join(f"  k{i}" for i in range(90)) + "\n};\n"
+        "class Scheme : public Base {\n public:\n"
+        "  Scheme(int a) : a_{a}, b_(a) {\n    a_ += 1;\n  }\n"
+        "  int shortOne(int x) const override { return x + a_; }\n"
+        f" private:\n  [[gnu::flatten]] int longOne(int x) {{\n    struct Local {{ int y; }};\n{body}\n    return x;\n  }}\n"
+        f"  struct Rows {{\n    CLONES int alsoLong(int x) {{\n{body}\n      return x;\n    }}\n  }};\n"
+        "  int a_ = 0, b_ = 0;\n};\n"
+        "}  // namespace enamel\n")
+    found = check_function_length.long_functions(src, 80)
+    assert [(name, n) for _, name, n in found] == [("Scheme::longOne", 89), ("Scheme::Rows::alsoLong", 88)]
+    assert [name for _, name, _ in check_function_length.long_functions(src, 88)] == ["Scheme::longOne"]
+    lines = src.read_text().splitlines()
+    assert lines[found[0][0] - 1].strip().startswith("[[gnu::flatten]] int longOne")
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "check_function_length.py"), str(src)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "Scheme::longOne (89 lines)" in r.stdout
+
+
+def test_a_short_method_and_a_short_function_pass(tmp_path):
+    src = tmp_path / "short.cpp"
+    src.write_text("namespace {\nstruct S {\n  int f(int x) {\n" + "    x += 1;\n" * 77 + "    return x;\n  }\n};\n"
+                   "int g(int x) {\n" + "  x += 1;\n" * 77 + "  return x;\n}\n}  // namespace\n")
+    assert check_function_length.long_functions(src, 80) == []
+    assert [(name, n) for _, name, n in check_function_length.long_functions(src, 79)] == [("S::f", 80), ("g", 80)]
