@@ -29,6 +29,23 @@ def test_an_include_up_a_layer_is_caught(tmp_path):
     assert "not in the layer table" in check_layers.violations([unknown])[0][0]
 
 
+def test_files_under_solver_lib_folders_are_named_by_their_path():
+    # the integrators' folder: its files include each other by their bare names and the library's by theirs
+    lumped = ROOT / "solver" / "lib" / "integrators" / "lumped.cpp"
+    assert check_layers.name_of(lumped) == "integrators/lumped"
+    assert check_layers.included_name(lumped, "node_rows.hpp") == "integrators/node_rows"
+    assert check_layers.included_name(lumped, "kernels.hpp") == "kernels"
+    assert lumped in check_layers.sources()
+
+
+def test_an_include_up_into_a_folder_is_caught(tmp_path):
+    bad = tmp_path / "kernels.cpp"  # layer 4 reaching into the schemes (layer 5)
+    bad.write_text('#include "kernels.hpp"\n#include "integrators/node_rows.hpp"\n')
+    found, checked = check_layers.violations([bad])
+    assert checked == 2
+    assert len(found) == 1 and "integrators/node_rows.hpp" in found[0] and "lower layer to a higher one" in found[0]
+
+
 def test_no_function_in_solver_is_over_80_lines():
     files = sorted([*ROOT.glob("solver/**/*.cpp"), *ROOT.glob("solver/**/*.hpp")])
     long = [(f.name, name, n) for f in files for _, name, n in check_function_length.long_functions(f, 80)]
