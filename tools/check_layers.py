@@ -3,7 +3,8 @@
 a lower one. Reads every `#include "..."` line of solver/lib/**/*.{hpp,cpp} and solver/app/*.cpp; prints each
 include that goes up a layer (and each file missing from the table) and exits 1 if there is any, else prints
 how many includes it checked and exits 0. A file is named by its path under solver/lib without the suffix
-(`integrators/lumped`); an include is looked for beside the including file first, then under solver/lib. Standard library only: `python3 tools/check_layers.py`."""
+(`integrators/lumped`); an include is looked for beside the including file first, then under solver/lib.
+Standard library only: `python3 tools/check_layers.py`."""
 from __future__ import annotations
 
 import pathlib
@@ -32,7 +33,8 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 
 def sources(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
-    return sorted([*root.glob("solver/lib/**/*.hpp"), *root.glob("solver/lib/**/*.cpp"), *root.glob("solver/app/*.cpp")])
+    lib = root / "solver" / "lib"
+    return sorted([*lib.glob("**/*.hpp"), *lib.glob("**/*.cpp"), *root.glob("solver/app/*.cpp")])
 
 
 def name_of(path: pathlib.Path) -> str:

@@ -77,7 +77,8 @@ def test_a_long_method_in_a_class_body_is_caught_and_a_short_one_is_not(tmp_path
         "class Scheme : public Base {\n public:\n"
         "  Scheme(int a) : a_{a}, b_(a) {\n    a_ += 1;\n  }\n"
         "  int shortOne(int x) const override { return x + a_; }\n"
-        f" private:\n  [[gnu::flatten]] int longOne(int x) {{\n    struct Local {{ int y; }};\n{body}\n    return x;\n  }}\n"
+        " private:\n  [[gnu::flatten]] int longOne(int x) {\n    struct Local { int y; };\n"
+        f"{body}\n    return x;\n  }}\n"
         f"  struct Rows {{\n    CLONES int alsoLong(int x) {{\n{body}\n      return x;\n    }}\n  }};\n"
         "  int a_ = 0, b_ = 0;\n};\n"
         "}  // namespace enamel\n")

@@ -30,7 +30,6 @@ SpMat selectRows(const SpMat& A, const std::vector<int>& rows) {
   return S;
 }
 
-
 // The paper's scheme (eq. 12-15): Newmark beta = 0 with consistent mass and Rayleigh damping. One step:
 //   w       = v_n + dt/2 a_n                              (predicted velocity, where the damping acts)
 //   q_{n+1} = q_n + dt v_n + dt^2/2 a_n                   (positions)

@@ -72,9 +72,10 @@ namespace {
 
 }  // namespace
 
-// advanceNodesOfSlice (node_rows.hpp): K_I q_n for every node of slice k into KIq (three pairs per node, from the slice's first), then advanceNode for
-// every node, W the wrench of its interfaces (node n's at W + stride (n - first node of the slice); stride 0: one
-// wrench for all), v_{n+1/2} and q_{n+1} to vOut and qOut (the slice's nodes in order, from its first).
+// advanceNodesOfSlice (node_rows.hpp): K_I q_n for every node of slice k into KIq (three pairs per node, from the
+// slice's first), then advanceNode for every node, W the wrench of its interfaces (node n's at
+// W + stride (n - first node of the slice); stride 0: one wrench for all), v_{n+1/2} and q_{n+1} to vOut and qOut
+// (the slice's nodes in order, from its first).
 // K_I q_n has a loop of its own: a node's row is one chain of ~21 dependent multiply-adds, and the CPU overlaps
 // the chains of several nodes only when nothing else stands between them in the instruction stream (with
 // advanceNode's ~250 instructions between them, the nodes pass took 1.17x as long on the paper preset).
@@ -82,8 +83,8 @@ namespace {
 // for three CPUs (target_clones), the loader picks one: x86-64-v4 (AVX-512), x86-64-v3 (AVX2, FMA: a * b + c
 // in one rounding where the code has one multiply and one add) where the CPU has them, else the default x86-64.
 ENAMEL_CPU_CLONES [[gnu::flatten]] SliceSums advanceNodesOfSlice(
-    NodeRows& rows, const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W, int stride,
-    DoublePair* KIq, double* vOut, double* qOut) {
+    NodeRows& rows, const Operators& ops, const NodeStep& c, int k, const double* q, const double* v, const double* W,
+    int stride, DoublePair* KIq, double* vOut, double* qOut) {
   SliceSums sums;
   const int firstNode = ops.sliceNodeStart[k];
   const int lastNode = ops.sliceNodeStart[k + 1];
