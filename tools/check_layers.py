@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The include layers of solver/lib (docs/contributing.md): each file may include only files of its own layer or
-a lower one. Reads every `#include "..."` line of solver/lib/*.{hpp,cpp} and solver/app/*.cpp; prints each
+a lower one. Reads every `#include "..."` line of solver/lib/**/*.{hpp,cpp} and solver/app/*.cpp; prints each
 include that goes up a layer (and each file missing from the table) and exits 1 if there is any, else prints
-how many includes it checked and exits 0. Standard library only: `python3 tools/check_layers.py`."""
+how many includes it checked and exits 0. A file is named by its path under solver/lib without the suffix
+(`integrators/lumped`); an include is looked for beside the including file first, then under solver/lib.
+Standard library only: `python3 tools/check_layers.py`."""
 from __future__ import annotations
 
 import pathlib
@@ -11,14 +13,16 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
-# Lowest first. A file's layer is that of its stem (foo.hpp and foo.cpp share one).
+# Lowest first. A file's layer is that of its name (foo.hpp and foo.cpp share one).
 LAYERS = [
     ("base", ["version", "exit_codes", "errors", "git_hash", "file_io"]),
     ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params", "resources"]),
     ("geometry", ["geometry", "far_field"]),
     ("plain data", ["state"]),
     ("loops over the data", ["kernels", "node_blocks", "loading_rate", "measurements", "static_solve"]),
-    ("schemes and set-up", ["integrators", "setup"]),
+    ("schemes and set-up", ["integrators", "integrators/step_parts", "integrators/node_rows",
+                            "integrators/slice_outputs", "integrators/newmark", "integrators/lumped",
+                            "integrators/schemes", "integrators/registry", "setup"]),
     ("the simulation", ["simulation"]),
     ("files and tools", ["output", "checkpoint", "profile"]),
     ("the run", ["runner"]),
@@ -29,27 +33,44 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 
 def sources(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
-    return sorted([*root.glob("solver/lib/*.hpp"), *root.glob("solver/lib/*.cpp"), *root.glob("solver/app/*.cpp")])
+    lib = root / "solver" / "lib"
+    return sorted([*lib.glob("**/*.hpp"), *lib.glob("**/*.cpp"), *root.glob("solver/app/*.cpp")])
+
+
+def name_of(path: pathlib.Path) -> str:
+    """A file's name in the table: its path under solver/lib without the suffix, else its stem."""
+    lib = ROOT / "solver" / "lib"
+    path = path.resolve()
+    return path.relative_to(lib).with_suffix("").as_posix() if path.is_relative_to(lib) else path.stem
+
+
+def included_name(including: pathlib.Path, include: str) -> str:
+    """The table name of `#include "include"` in file `including`: beside it first, then under solver/lib."""
+    for base in (including.parent, ROOT / "solver" / "lib"):
+        if (base / include).is_file():
+            return name_of(base / include)
+    return pathlib.PurePosixPath(include).with_suffix("").as_posix()
 
 
 def violations(files: list[pathlib.Path]) -> tuple[list[str], int]:
     """(messages, number of includes checked)."""
     out, checked = [], 0
     for f in files:
-        if f.stem not in LAYER_OF:
+        me = name_of(f)
+        if me not in LAYER_OF:
             out.append(f"{f.name}: not in the layer table of tools/check_layers.py")
             continue
-        mine = LAYER_OF[f.stem]
+        mine = LAYER_OF[me]
         for n, line in enumerate(f.read_text(errors="replace").splitlines(), 1):
             m = INCLUDE.match(line)
             if not m:
                 continue
             checked += 1
-            stem = pathlib.Path(m[1]).stem
-            if stem not in LAYER_OF:
+            other = included_name(f, m[1])
+            if other not in LAYER_OF:
                 out.append(f"{f.name}:{n}: includes {m[1]}, which is not in the layer table")
-            elif LAYER_OF[stem] > mine:
-                out.append(f"{f.name}:{n}: includes {m[1]} (layer {LAYER_OF[stem]} {LAYERS[LAYER_OF[stem]][0]!r}) "
+            elif LAYER_OF[other] > mine:
+                out.append(f"{f.name}:{n}: includes {m[1]} (layer {LAYER_OF[other]} {LAYERS[LAYER_OF[other]][0]!r}) "
                            f"from layer {mine} {LAYERS[mine][0]!r}: an include from a lower layer to a higher one")
     return out, checked
 

@@ -1,10 +1,12 @@
 #pragma once
 // Time integrators. `paper` is the reference (paper eq. 12-18); fast schemes sit beside it behind the same
-// small interface and are chosen by the case key `integrator`. A scheme keeps its own data (dt, its mass or
+// small interface, one scheme per file of solver/lib/integrators/, and are chosen by the case key `integrator`
+// from the table of integratorRegistry(). A scheme keeps its own data (dt, its mass or
 // factorisation, scratch); it is given the set-up data by const reference and the State by reference.
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "case_params.hpp"
 #include "errors.hpp"  // IntegratorError, SolverError (kept here for the files that include them through this one)
@@ -19,7 +21,8 @@ class Integrator {
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
   virtual double timeStep() const = 0;
-  /// Advance s from t_n to t_n + dt, as the scheme's doc comment lists the step (integrators.cpp): forces,
+  /// Advance s from t_n to t_n + dt, as the scheme's doc comment lists the step (integrators/newmark.cpp,
+  /// integrators/lumped.cpp): forces,
   /// velocities, positions, boundary conditions, reactions and the work of the grips, damping work.
   virtual void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) = 0;
   /// Make the scheme's own state consistent with a given q, v at s.time (a run from rest needs nothing):
@@ -50,8 +53,20 @@ class Integrator {
   virtual std::string describe() const { return name(); }
 };
 
-/// The integrator named by p.integrator, set up for these operators. Throws IntegratorError when dt is above
-/// the stable limit, SolverError when a factorisation fails.
+/// A scheme's factory: the scheme set up for these operators.
+using IntegratorFactory = std::unique_ptr<Integrator> (*)(const CaseParams& p, const Model& m, const Materials& mat,
+                                                          const Operators& ops);
+/// A row of the table of schemes: the `integrator` key's value that chooses it, and its factory.
+struct IntegratorEntry {
+  const char* name;
+  IntegratorFactory make;
+};
+/// Every scheme of this build, in the order of the `integrator` key's choices (integrators/registry.cpp).
+const std::vector<IntegratorEntry>& integratorRegistry();
+
+/// The integrator named by p.integrator (its row of integratorRegistry()), set up for these operators. Throws
+/// IntegratorError when no row has that name, when dt is above the stable limit; SolverError when a factorisation
+/// fails.
 std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, const Materials& mat,
                                            const Operators& ops);
 

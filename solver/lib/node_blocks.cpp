@@ -6,7 +6,7 @@
 #include <string>
 #include <unordered_map>
 
-// AVX-512 rows where GCC builds for x86-64 (as the node rows' clones, integrators.cpp)
+// AVX-512 rows where GCC builds for x86-64 (as the node rows' clones, integrators/node_rows.cpp)
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define ENAMEL_HAS_AVX512_ROWS 1

@@ -1,6 +1,6 @@
 #pragma once
-// Stiffnesses in 6 x 6 node blocks, for the lumped step's per-node rows (integrators.cpp): the rods' K and the
-// elastic interfaces' (kernels.hpp elasticInterfaceBlocks); each distinct block stored once, and where a
+// Stiffnesses in 6 x 6 node blocks, for the lumped step's per-node rows (integrators/node_rows.cpp): the rods' K
+// and the elastic interfaces' (kernels.hpp elasticInterfaceBlocks); each distinct block stored once, and where a
 // stiffness never couples two groups of a node's DOFs (DofGroups) only the 18 entries that can be non-zero.
 // Plain data and inline loops; no I/O.
 #include <Eigen/Dense>

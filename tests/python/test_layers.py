@@ -29,6 +29,23 @@ def test_an_include_up_a_layer_is_caught(tmp_path):
     assert "not in the layer table" in check_layers.violations([unknown])[0][0]
 
 
+def test_files_under_solver_lib_folders_are_named_by_their_path():
+    # the integrators' folder: its files include each other by their bare names and the library's by theirs
+    lumped = ROOT / "solver" / "lib" / "integrators" / "lumped.cpp"
+    assert check_layers.name_of(lumped) == "integrators/lumped"
+    assert check_layers.included_name(lumped, "node_rows.hpp") == "integrators/node_rows"
+    assert check_layers.included_name(lumped, "kernels.hpp") == "kernels"
+    assert lumped in check_layers.sources()
+
+
+def test_an_include_up_into_a_folder_is_caught(tmp_path):
+    bad = tmp_path / "kernels.cpp"  # layer 4 reaching into the schemes (layer 5)
+    bad.write_text('#include "kernels.hpp"\n#include "integrators/node_rows.hpp"\n')
+    found, checked = check_layers.violations([bad])
+    assert checked == 2
+    assert len(found) == 1 and "integrators/node_rows.hpp" in found[0] and "lower layer to a higher one" in found[0]
+
+
 def test_no_function_in_solver_is_over_80_lines():
     files = sorted([*ROOT.glob("solver/**/*.cpp"), *ROOT.glob("solver/**/*.hpp")])
     long = [(f.name, name, n) for f in files for _, name, n in check_function_length.long_functions(f, 80)]
@@ -70,3 +87,41 @@ def test_a_dependency_on_the_notebook_is_caught(tmp_path):
     assert len(found) == 3, found
     assert found[0].startswith("pipeline/jobs.py:2:") and found[1].startswith("pipeline/jobs.py:3:")
     assert found[2].startswith("runner.hpp:1:")
+
+
+def test_a_long_method_in_a_class_body_is_caught_and_a_short_one_is_not(tmp_path):
+    # Methods are measured where they stand: inside class and struct bodies (nested ones too), inline in a
+    # header, after access specifiers, attributes and a constructor's braced initialisers; an enum, a braced
+    # table and a local struct are not functions of their own.
+    body = "\n".join(f"    x += {i};" for i in range(85))
+    table = ",\n".join(f"  {i}" for i in range(90))
+    src = tmp_path / "scheme.hpp"
+    src.write_text(
+        "#pragma once\n#define CLONES [[gnu::target_clones(\"arch=x86-64-v3\", \"default\")]]\n"
+        "namespace enamel {\n"
+        f"inline constexpr int kTable[] = {{\n{table}\n}};\n"
+        "enum class Kind : int {\n" + ",\n".join(f"  k{i}" for i in range(90)) + "\n};\n"
+        "class Scheme : public Base {\n public:\n"
+        "  Scheme(int a) : a_{a}, b_(a) {\n    a_ += 1;\n  }\n"
+        "  int shortOne(int x) const override { return x + a_; }\n"
+        " private:\n  [[gnu::flatten]] int longOne(int x) {\n    struct Local { int y; };\n"
+        f"{body}\n    return x;\n  }}\n"
+        f"  struct Rows {{\n    CLONES int alsoLong(int x) {{\n{body}\n      return x;\n    }}\n  }};\n"
+        "  int a_ = 0, b_ = 0;\n};\n"
+        "}  // namespace enamel\n")
+    found = check_function_length.long_functions(src, 80)
+    assert [(name, n) for _, name, n in found] == [("Scheme::longOne", 89), ("Scheme::Rows::alsoLong", 88)]
+    assert [name for _, name, _ in check_function_length.long_functions(src, 88)] == ["Scheme::longOne"]
+    lines = src.read_text().splitlines()
+    assert lines[found[0][0] - 1].strip().startswith("[[gnu::flatten]] int longOne")
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "check_function_length.py"), str(src)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "Scheme::longOne (89 lines)" in r.stdout
+
+
+def test_a_short_method_and_a_short_function_pass(tmp_path):
+    src = tmp_path / "short.cpp"
+    src.write_text("namespace {\nstruct S {\n  int f(int x) {\n" + "    x += 1;\n" * 77 + "    return x;\n  }\n};\n"
+                   "int g(int x) {\n" + "  x += 1;\n" * 77 + "  return x;\n}\n}  // namespace\n")
+    assert check_function_length.long_functions(src, 80) == []
+    assert [(name, n) for _, name, n in check_function_length.long_functions(src, 79)] == [("S::f", 80), ("g", 80)]
