@@ -21,12 +21,7 @@ Vec3 Model::rodDirection(int ply) const {
   return Vec3(std::cos(theta), sign * std::sin(theta), 0.0);
 }
 
-// Rod centre lines (docs/model.md), with the origin of x put on a crisscross point of the mid-plane:
-//   ply 1:  y = yCrack + j s + (x - xCrisscross) tan(theta)
-//   ply 2:  y = yCrack + j s - (x - xCrisscross) tan(theta)
-// so that rod 0 of both plies crosses the mid-plane at xCrisscross. At theta = 0 there is no crisscross:
-// the plies are hexagonally packed, ply 1 at yCrack - d/4 + j d and ply 2 at yCrack + d/4 + j d, and the
-// mid-plane runs between the two rows.
+// The pre-crack tip at a quarter point of the slice lattice (geometry.hpp, docs/model.md Geometry).
 PrecrackTip precrackTip(double a0, double h_e) {
   PrecrackTip tip;
   tip.lastSlice = static_cast<int>(std::floor(a0 / h_e + kTipSnapTolerance));
@@ -36,6 +31,12 @@ PrecrackTip precrackTip(double a0, double h_e) {
 
 bool belowCrackPlane(const Model& m, double y) { return y < m.yCrack - kCrackPlaneTolerance * m.d; }
 
+// Rod centre lines (docs/model.md), with the origin of x put on a crisscross point of the mid-plane:
+//   ply 1:  y = yCrack + j s + (x - xCrisscross) tan(theta)
+//   ply 2:  y = yCrack + j s - (x - xCrisscross) tan(theta)
+// so that rod 0 of both plies crosses the mid-plane at xCrisscross. At theta = 0 there is no crisscross:
+// the plies are hexagonally packed, ply 1 at yCrack - d/4 + j d and ply 2 at yCrack + d/4 + j d, and the
+// mid-plane runs between the two rows.
 double rodCentreY(const Model& m, int ply, int j, double x) {
   if (m.theta == 0.0) return m.yCrack + (ply == 0 ? -0.25 : 0.25) * m.d + j * m.s;
   const double sign = ply == 0 ? 1.0 : -1.0;
