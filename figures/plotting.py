@@ -91,7 +91,7 @@ def draw_process_zone(ax, r: Result, frame: Frame, tag: int, ply: int | None, ti
             segs = np.stack([X[bn[m, 0], :2], X[bn[m, 1], :2]], axis=1)
             ax.add_collection(LineCollection(segs, colors="black", linewidths=max(1.2, 0.25 * width_pt / ws),
                                              zorder=4))
-    a0, yc = a.get("a0"), a.get("y_crack_plane")
+    a0, yc = a["a0_effective"], a.get("y_crack_plane")  # the tip Delta_a is measured from
     if a0 is not None and yc is not None:
         ax.plot([0, a0], [yc, yc], color="#1f77b4", linewidth=1.0, zorder=5)
     ax.set_title(title, fontsize=9)

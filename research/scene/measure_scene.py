@@ -46,7 +46,7 @@ def frame_scene(r: results.Result, f: results.Frame, rod_fraction: float) -> dic
     """The scene of one frame (see the module doc)."""
     g = r.geometry
     yc = float(g.attrs["y_crack_plane"])
-    a0 = float(g.attrs["a0"])
+    a0 = float(g.attrs["a0_effective"])  # the tip Delta_a is measured from (docs/model.md)
     h_e = float(g.attrs["h_e"])
     tip = a0 + f.da
     mid = g.iface_midpoint[:, :2]

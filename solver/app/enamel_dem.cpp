@@ -79,6 +79,10 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   std::printf("theta_D            %g deg   Er/kd %g   sigma_ru/sigma0 %g   cv %g\n", p.theta_D, p.Er_over_kd,
               p.sigma_ru_over_sigma0, p.cv);
   std::printf("specimen           w_s %g d x h_s %g d, z-period B %.4f d, pre-crack a0 %g d\n", m.w_s, m.h_s, m.B, m.a0);
+  std::printf("pre-crack tip      a0_eff %.6g d = (K + 1/4) h_e, K = %d (cut through slice K)", m.a0Eff,
+              m.precrackLastSlice);
+  if (m.theta > 0) std::printf(", a crisscross at x = %.6g d (crisscross_at_tip %s)", m.xCrisscross, p.crisscross_at_tip.c_str());
+  std::printf("\n");
   std::printf("slices             %d (h_e %.4f d)\n", m.numSlices, m.h_e);
   std::printf("rods               %d\n", m.numRods());
   std::printf("nodes              %d\n", m.numNodes());

@@ -102,9 +102,13 @@ enum class Need { required, optional };
     X(h_e_over_d, Real, numerics, optional, 0.3, "(]", 0, 1, "", "d",                                               \
       "slice spacing: distance h_e between discrete yz layers (paper: 0.3 coarse, 0.15 fine; "                      \
       "h_e larger than d is an error)")                                                                             \
+    X(crisscross_at_tip, Choice, numerics, optional, "intact", "[]", 0, 0, "intact|cut", "-",                     \
+      "crisscross at the tip: the origin of the crisscross lattice, intact = a crisscross point at the pre-crack "  \
+      "tip a0_eff = (K + 1/4) h_e, its rods intact (in element [K, K+1]); cut = at a0_eff - h_e/2, its rods cut "   \
+      "by the pre-crack (paper Fig. 4: the first intact crisscross ~d/sin(theta_D) ahead) (docs/model.md)")        \
     X(crisscross_phase, Real, numerics, optional, 0, "[)", 0, 1, "", "d/sin(theta_D)",                              \
-      "crisscross phase: position of the first crisscross point ahead of the pre-crack tip, as a "                  \
-      "fraction of the crisscross spacing d/sin(theta_D) (no effect at theta_D = 0)")                               \
+      "crisscross phase: the crisscross points sit at the origin set by crisscross_at_tip plus this fraction of "   \
+      "the crisscross spacing d/sin(theta_D), and every d/sin(theta_D) from there (no effect at theta_D = 0)")      \
     X(v_app_over_cd, Real, numerics, optional, 1e-3, "(]", 0, 0.1, "", "c_d",                                       \
       "loading rate: peak applied velocity at the cracked edge / transverse wave speed c_d")                        \
     X(rate_factor, Real, numerics, optional, 1, "(]", 0, 1e3, "", "-",                                              \
@@ -156,6 +160,12 @@ enum class Need { required, optional };
     X(stop_u_over_d, Real, numerics, optional, 1e3, "(]", 0, 1e6, "", "d",                                          \
       "stop displacement: the run stops when the applied displacement at the cracked edge "                         \
       "reaches this")                                                                                               \
+    X(stop_load_fraction, Real, numerics, optional, 0.05, "[)", 0, 1, "", "peak load",                           \
+      "stop when separated: once the crack has started, the run stops (stop_reason \"separated: ...\") when the "    \
+      "grip load stays below this fraction of its peak for stop_load_transits transit times; 0 = off")             \
+    X(stop_load_transits, Real, numerics, optional, 1, "(]", 0, 1e3, "", "h_s/c_d",                                \
+      "stop when separated: how long the load must stay below stop_load_fraction of its peak, in transit times "   \
+      "h_s/c_d (checked at history rows)")                                                                          \
     X(max_steps, Integer, numerics, optional, 0, "[]", 0, 4611686018427387904.0 /* 2^62 */, "", "steps",            \
       "step limit: the run stops after this many time steps; 0 = no limit")                                         \
     X(history_every, Integer, numerics, optional, 0, "[]", 0, 1e9, "", "steps",                                     \

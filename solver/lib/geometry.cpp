@@ -21,6 +21,16 @@ Vec3 Model::rodDirection(int ply) const {
   return Vec3(std::cos(theta), sign * std::sin(theta), 0.0);
 }
 
+// The pre-crack tip at a quarter point of the slice lattice (geometry.hpp, docs/model.md Geometry).
+PrecrackTip precrackTip(double a0, double h_e) {
+  PrecrackTip tip;
+  tip.lastSlice = static_cast<int>(std::floor(a0 / h_e + kTipSnapTolerance));
+  tip.a0Eff = (tip.lastSlice + 0.25) * h_e;
+  return tip;
+}
+
+bool belowCrackPlane(const Model& m, double y) { return y < m.yCrack - kCrackPlaneTolerance * m.d; }
+
 // Rod centre lines (docs/model.md), with the origin of x put on a crisscross point of the mid-plane:
 //   ply 1:  y = yCrack + j s + (x - xCrisscross) tan(theta)
 //   ply 2:  y = yCrack + j s - (x - xCrisscross) tan(theta)
@@ -173,13 +183,20 @@ Model modelConstants(const GeometryParams& p) {
   m.numSlices = static_cast<int>(std::lround(p.w_s / p.h_e)) + 1;
   m.h_e = p.w_s / (m.numSlices - 1);
   m.yCrack = 0.5 * p.h_s;
-  m.xCrisscross = m.theta > 0 ? p.a0 + p.crisscross_phase * m.d / std::sin(m.theta) : p.a0;
+  const PrecrackTip tip = precrackTip(p.a0, m.h_e);
+  m.precrackLastSlice = tip.lastSlice;
+  m.a0Eff = tip.a0Eff;
+  // The crisscross lattice: its origin is the tip (its rods cross the mid-plane inside the intact element
+  // [K, K+1]) or half a slice behind it (inside the last cut element [K-1, K]: the paper's Fig. 4), shifted by
+  // crisscross_phase crisscross spacings d/sin(theta) ahead.
+  const double origin = p.crisscrossCutAtTip ? tip.a0Eff - 0.5 * m.h_e : tip.a0Eff;
+  m.xCrisscross = m.theta > 0 ? origin + p.crisscross_phase * m.d / std::sin(m.theta) : origin;
   m.beamLength = m.h_e / std::cos(m.theta);
   return m;
 }
 
 // One rod (ply, j) with its nodes in slices first .. first + count - 1 and the rod elements between them; a
-// rod element crossing the mid-plane behind the pre-crack tip is cut by the pre-crack.
+// rod element [k-1, k] with k <= K (precrackTip) that crosses the mid-plane is cut by the pre-crack.
 void addRod(Model& m, const GeometryParams& p, int ply, int j, int first, int count,
             std::vector<std::vector<int>>& sliceNodes) {
   const int rod = m.numRods();
@@ -194,9 +211,8 @@ void addRod(Model& m, const GeometryParams& p, int ply, int j, int first, int co
     m.nodePly.push_back(static_cast<std::int8_t>(ply));
     sliceNodes[k].push_back(node);
     if (k == first) continue;
-    const double ya = m.X[node - 1].y(), yb = m.X[node].y();
-    const bool crosses = (ya < m.yCrack) != (yb < m.yCrack);
-    if (p.precrack && crosses && x - 0.5 * m.h_e < p.a0) {
+    const bool crosses = belowCrackPlane(m, m.X[node - 1].y()) != belowCrackPlane(m, m.X[node].y());
+    if (p.precrack && crosses && k <= m.precrackLastSlice) {
       ++m.precrackBeams;
       m.precrackBeamRod.push_back(rod);
       m.precrackBeamSlice.push_back(k - 1);
@@ -251,8 +267,8 @@ void addInterface(Model& m, int k, int nA, int nB, int shift, const Vec3& mid, d
   m.ifaceZShift.push_back(static_cast<std::int8_t>(shift));
 }
 
-// The interfaces of slice k: Voronoi neighbours, periodic in z; those across the mid-plane behind the
-// pre-crack tip are the pre-crack.
+// The interfaces of slice k: Voronoi neighbours, periodic in z; those across the mid-plane in slices k <= K
+// (precrackTip) are the pre-crack.
 void addInterfacesOfSlice(Model& m, const GeometryParams& p, int k, const std::vector<int>& ids) {
   std::vector<Vec2> pts;
   pts.reserve(ids.size());
@@ -275,7 +291,7 @@ void addInterfacesOfSlice(Model& m, const GeometryParams& p, int k, const std::v
         shift = -shift;
       }
       const Vec3 xA = m.X[nA], xB = m.X[nB] + Vec3(0, 0, shift * m.B);
-      if (p.precrack && x < p.a0 && (xA.y() < m.yCrack) != (xB.y() < m.yCrack)) {
+      if (p.precrack && k <= m.precrackLastSlice && belowCrackPlane(m, xA.y()) != belowCrackPlane(m, xB.y())) {
         ++m.precrackInterfaces;
         m.precrackIfaceRods.push_back({m.nodeRod[nA], m.nodeRod[nB]});
         m.precrackIfaceSlice.push_back(k);

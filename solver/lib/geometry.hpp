@@ -31,7 +31,8 @@ struct GeometryParams {
   double h_s = 16;               // specimen height (y)
   double a0 = 16;                // pre-crack length, on the mid-plane y = h_s/2, from x = 0
   double h_e = 0.3;              // requested slice spacing (adjusted so that w_s is a whole number of slices)
-  double crisscross_phase = 0;   // first crisscross point ahead of the tip at a0 + phase * d/sin(theta)
+  double crisscross_phase = 0;   // the crisscross lattice's shift from its origin, in d/sin(theta) (docs/model.md)
+  bool crisscrossCutAtTip = false;  // origin: false a0_eff (its rods intact), true a0_eff - h_e/2 (cut: paper Fig. 4)
   bool precrack = true;          // false: an uncracked block (used to measure the transverse modulus)
 };
 
@@ -51,7 +52,9 @@ struct Model {
   double s = 1;            // in-slice rod spacing d / cos(theta)
   double t = 0;            // ply thickness sqrt(3)/2 d
   double B = 0;            // z-period sqrt(3) d
-  double w_s = 0, h_s = 0, a0 = 0, h_e = 0;  // h_e is the slice spacing actually used
+  double w_s = 0, h_s = 0, a0 = 0, h_e = 0;  // h_e is the slice spacing actually used; a0 as requested
+  int precrackLastSlice = -1;  // K: the pre-crack removes what crosses the mid-plane in slices 0..K (precrackTip)
+  double a0Eff = 0;        // the pre-crack tip the model has: (K + 1/4) h_e (Delta_a is measured from it)
   double yCrack = 0;       // mid-plane y = h_s / 2
   double xCrisscross = 0;  // a crisscross point on the mid-plane (theta > 0)
   int numSlices = 0;
@@ -105,6 +108,22 @@ struct Model {
   int numDofs() const { return 6 * numNodes(); }
 };
 
+/// The pre-crack tip (docs/model.md, Geometry): snapped to a quarter point of the slice lattice, so that no
+/// round-off in a0 or h_e decides what the pre-crack removes. K = floor(a0/h_e + 1e-6); the pre-crack removes
+/// the interfaces of slices k <= K and the rod elements [k-1, k] with k <= K that cross the mid-plane, and the
+/// tip is a0_eff = (K + 1/4) h_e: between the last cut slice and the first intact element's midpoint.
+struct PrecrackTip {
+  int lastSlice = -1;  // K
+  double a0Eff = 0;    // (K + 1/4) h_e
+};
+PrecrackTip precrackTip(double a0, double h_e);
+constexpr double kTipSnapTolerance = 1e-6;   // in slices: a0/h_e this close below an integer counts as it
+constexpr double kCrackPlaneTolerance = 1e-6;  // d: a node this close to the mid-plane counts as above it
+
+/// Whether a point at height y lies below the mid-plane for the pre-crack's cuts: y < yCrack - 1e-6 d, so a
+/// node on the plane (a crisscross point on a slice) is on one fixed side whatever the round-off.
+bool belowCrackPlane(const Model& m, double y);
+
 /// y of the centre of rod j of a ply at position x (the analytic rod centre line).
 double rodCentreY(const Model& m, int ply, int j, double x);
 
@@ -122,10 +141,16 @@ struct VoronoiCell {
   double perimeter = 0;
 };
 
+/// Edges shorter than this (d) are no interface: where a slice's plies are aligned (ply-1 and ply-2 rods at the
+/// same y, every d/(2 sin theta) along x) the section is a rectangular lattice whose Voronoi vertices join four
+/// cells, and round-off makes each diagonal an edge of length ~1e-9 or none; 1e-6 d drops them whatever the
+/// round-off (before 2026-12-06: 1e-9, and a hair of h_e changed the ci theta30 specimen's interfaces).
+constexpr double kMinVoronoiEdge = 1e-6;
+
 /// Voronoi tessellation of points (y, z) in the strip yLo <= y <= yHi, periodic in z with period `period`.
 /// Cells are clipped by the strip; edges shorter than minEdge are dropped (degenerate vertices).
 std::vector<VoronoiCell> computeSliceVoronoi(const std::vector<Vec2>& points, double period, double yLo,
-                                             double yHi, double minEdge = 1e-9);
+                                             double yHi, double minEdge = kMinVoronoiEdge);
 
 /// Build the whole crossply specimen. Throws std::invalid_argument on impossible parameters.
 Model buildCrossply(const GeometryParams& p);

@@ -204,7 +204,7 @@ double farthestConnectedX(const CrackGraph& g) {
 }  // namespace
 
 double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State& s) {
-  return std::max(0.0, farthestConnectedX(collectCrackElements(m, law, s)) - m.a0);
+  return std::max(0.0, farthestConnectedX(collectCrackElements(m, law, s)) - m.a0Eff);
 }
 
 double computeGripLoad(const Operators& ops, const State& s) {

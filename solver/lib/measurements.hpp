@@ -43,7 +43,9 @@ double faceEnergyDensity(const Model& m, const Materials& mat, const State& s, i
 double computeJ(const Model& m, const Materials& mat, const Operators& ops, const State& s);
 
 /// Delta_a: the connected cluster of failed interfaces and deleted rod elements that touches the pre-crack,
-/// max x over it - a0 (projected on x; daughter cracks count once they join).
+/// max x over it - a0_eff (projected on x; daughter cracks count once they join). Two elements are connected
+/// when they touch the same rod in the same or adjacent slices, so the cluster follows a crack on any path:
+/// through either ply and the interlayers, kinked or deflected off the mid-plane.
 double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State& s);
 
 /// The generalised force conjugate to U: sum of F_y x shape over the prescribed DOFs.

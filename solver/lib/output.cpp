@@ -257,6 +257,8 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "shear_strength_ratio", p.shear_strength_ratio);
   attr(g.id, "grip_constraint", p.grip_constraint);
   attr(g.id, "grip_profile", p.grip_profile);
+  attr(g.id, "crisscross_at_tip", p.crisscross_at_tip);
+  attr(g.id, "a0_effective", sim.model.a0Eff);  // the pre-crack tip (K + 1/4) h_e that Delta_a is measured from
   attr(g.id, "sigma_ru_mean", p.sigma_ru());
   const StaticStart& st = rec.staticStart;
   attr(g.id, "static_start", st.fraction);
@@ -339,6 +341,7 @@ void writeGeometry(hid_t file, const Simulation& sim) {
   attr(g.id, "w_s", m.w_s);
   attr(g.id, "h_s", m.h_s);
   attr(g.id, "a0", m.a0);
+  attr(g.id, "a0_effective", m.a0Eff);
   attr(g.id, "h_e", m.h_e);
   attr(g.id, "z_period_B", m.B);
   attr(g.id, "ply_thickness", m.t);

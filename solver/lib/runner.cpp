@@ -97,6 +97,15 @@ double quasiStaticRatio(const Measurement& r) {
   return std::max(beyond, r.crackAdvance > 0 ? kineticOverStrain(r) : 0.0);
 }
 
+LoadDropWatch watchLoadDrop(LoadDropWatch w, const Measurement& r, double fraction, double hold) {
+  w.peakLoad = std::max(w.peakLoad, r.load);
+  const bool below = fraction > 0 && r.crackAdvance > 0 && w.peakLoad > 0 && r.load < fraction * w.peakLoad;
+  if (!below) w.belowSince = NAN;
+  else if (std::isnan(w.belowSince)) w.belowSince = r.time;
+  w.separated = w.separated || (below && r.time - w.belowSince >= hold);
+  return w;
+}
+
 void requestStop(int signal) { gStopSignal = signal; }
 
 namespace {
@@ -236,6 +245,7 @@ class RunLoop {
       if (p_.static_start > 0) startFromStaticElastic();
       rec_.history.push_back(sim_.measure());
     }
+    for (const Measurement& r : rec_.history) watchLoad(r);  // from rest: one row; a restart: every row read back
     save();
     // Progress rates are measured over this piece of the run, and the crack's from where it started.
     marks_.piece = marks_.crackStart = marks_.lastAdvance = sample();
@@ -292,7 +302,14 @@ class RunLoop {
 
   Measurement recordHistory() {
     rec_.history.push_back(sim_.measure());
+    watchLoad(rec_.history.back());
     return rec_.history.back();
+  }
+
+  /// The separated-specimen watch (watchLoadDrop) on one more history row.
+  void watchLoad(const Measurement& r) {
+    const double transit = sim_.model.h_s / sim_.materials.c_d;
+    loadWatch_ = watchLoadDrop(loadWatch_, r, p_.stop_load_fraction, p_.stop_load_transits * transit);
   }
 
   /// The quasi-static and stability checks (docs/solver.md, Time integration and checks) on a history row: false when the run failed
@@ -406,11 +423,15 @@ class RunLoop {
     const State& s = sim_.state;
     const Model& m = sim_.model;
     const double U = s.appliedDisplacement;
-    const double maxX = m.a0 + s.crackAdvance;
+    const double maxX = m.a0Eff + s.crackAdvance;
     if (s.crackAdvance >= p_.stop_da_over_d)
       rec_.stopReason = fmt("crack advance %.3g d reached stop_da_over_d = %g", s.crackAdvance, p_.stop_da_over_d);
     else if (maxX >= m.w_s - 2 * m.h_e)
-      rec_.stopReason = fmt("crack reached the far edge (x = %.3g d of w_s = %g d)", maxX, m.w_s);
+      rec_.stopReason = fmt("separated: crack reached the far edge (x = %.3g d of w_s = %g d)", maxX, m.w_s);
+    else if (loadWatch_.separated)
+      rec_.stopReason = fmt("separated: the grip load stayed below stop_load_fraction = %g of its peak %.4g since t = %.6g "
+                            "(stop_load_transits = %g transit times; Delta_a %.3g d)", p_.stop_load_fraction,
+                            loadWatch_.peakLoad, loadWatch_.belowSince, p_.stop_load_transits, s.crackAdvance);
     else if (U >= p_.stop_u_over_d)
       rec_.stopReason = fmt("applied displacement %.4g d reached stop_u_over_d = %g", U, p_.stop_u_over_d);
     else if (p_.max_steps > 0 && s.step >= p_.max_steps)
@@ -488,6 +509,7 @@ class RunLoop {
   double lastWrite_ = 0, lastProgress_ = 0, lastCheckpoint_ = 0, lastDa_ = 0;
   std::size_t nextFrame_ = 0;
   ProgressMarks marks_;  // where the progress line's rates are measured from
+  LoadDropWatch loadWatch_;  // the separated-specimen stop
 };
 
 }  // namespace

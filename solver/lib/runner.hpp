@@ -121,6 +121,17 @@ bool resistanceIsPhysical(double J, const GuardBounds& b);
 /// strain energy (`kineticRatio`, 0 before the crack grows). A pure function of the row.
 std::string blowUpCheck(const Measurement& r, double kineticRatio, const GuardBounds& b);
 
+/// The stop for a separated specimen (case keys stop_load_fraction, stop_load_transits; docs/model.md, Loading,
+/// damping, measurements): a fold over the history rows, so a restart rebuilds it from the rows it read back.
+struct LoadDropWatch {
+  double peakLoad = 0;      // the largest grip load of any row so far
+  double belowSince = NAN;  // time of the first row of the current run of rows below fraction x peak with the
+                            // crack started (NaN: the last row was not)
+  bool separated = false;   // the load stayed below for `hold` or longer
+};
+/// The watch after one more row r: with fraction <= 0 it never reports separated.
+LoadDropWatch watchLoadDrop(LoadDropWatch w, const Measurement& r, double fraction, double hold);
+
 /// Ask a running simulation to stop at the next step (signal handlers call this).
 void requestStop(int signal);
 

@@ -25,6 +25,7 @@ GeometryParams geometryOf(const CaseParams& p) {
   g.a0 = p.a0();
   g.h_e = p.h_e_over_d;
   g.crisscross_phase = p.crisscross_phase;
+  g.crisscrossCutAtTip = p.crisscross_at_tip == "cut";
   return g;
 }
 

@@ -71,8 +71,8 @@ TEST(Geometry, VoronoiEdgesCloseEachCellPerimeterAndTileTheStrip) {
       for (const auto& c : cells) {
         double sumEdges = 0;
         for (const auto& e : c.edges) sumEdges += e.length;
-        // Dropped degenerate edges are shorter than 1e-9 each: the edges close the perimeter.
-        EXPECT_NEAR(sumEdges, c.perimeter, 1e-8) << "theta " << theta << " slice " << k;
+        // Dropped degenerate edges are shorter than kMinVoronoiEdge each: the edges close the perimeter.
+        EXPECT_NEAR(sumEdges, c.perimeter, 10 * kMinVoronoiEdge) << "theta " << theta << " slice " << k;
         EXPECT_GT(c.area, 0);
         totalArea += c.area;
       }
@@ -112,13 +112,13 @@ TEST(Geometry, CrisscrossPointsAlongMidPlaneAreDOverSinThetaApart) {
     std::sort(xs.begin(), xs.end());
     for (std::size_t i = 1; i < xs.size(); ++i)
       EXPECT_NEAR(xs[i] - xs[i - 1], 1.0 / std::sin(m.theta), kGeomTol) << "theta " << theta;
-    // Default phase 0 puts a crisscross point at the pre-crack tip.
-    EXPECT_NEAR(m.xCrisscross, m.a0, kGeomTol);
+    // Default phase 0 puts a crisscross point at the pre-crack tip a0_eff.
+    EXPECT_NEAR(m.xCrisscross, m.a0Eff, kGeomTol);
   }
   GeometryParams p = smallParams(30, 40, 8);
   p.crisscross_phase = 0.25;
   const Model m = buildCrossply(p);
-  EXPECT_NEAR(m.xCrisscross - m.a0, 0.25 / std::sin(M_PI / 6), kGeomTol);
+  EXPECT_NEAR(m.xCrisscross - m.a0Eff, 0.25 / std::sin(M_PI / 6), kGeomTol);
 }
 
 TEST(Geometry, PeriodicWrapJoinsPly2ToPly1OfTheNextPeriod) {
@@ -150,29 +150,32 @@ TEST(Geometry, PeriodicWrapJoinsPly2ToPly1OfTheNextPeriod) {
 TEST(Geometry, HandCountOnSmallTheta0Specimen) {
   // w_s = 6, h_s = 4, h_e = 0.3: 21 slices. Ply 1 rods at y = 0.75, 1.75, 2.75, 3.75; ply 2 at 0.25, 1.25,
   // 2.25, 3.25 (4 + 4 rods, every rod in every slice). Per slice: in-ply 3 + 3, interlayer 1-2: 7, wrap
-  // 2-1: 7 => 20 interfaces. Pre-crack (x < a0 = 3: slices 0..9) cuts across y = 2: ply 1 (1.75|2.75),
-  // ply 2 (1.25|2.25), interlayer 1.75-2.25 and wrap 2.25-(1.75 image) => 4 per slice, 40 in all.
+  // 2-1: 7 => 20 interfaces. Pre-crack (a0 = 3 = 10 h_e: K = 10, slices 0..10, tip a0_eff = 10.25 h_e) cuts
+  // across y = 2: ply 1 (1.75|2.75), ply 2 (1.25|2.25), interlayer 1.75-2.25 and wrap 2.25-(1.75 image) => 4 per
+  // slice, 44 in all.
   const Model m = buildCrossply(smallParams(0, 6, 4));
   EXPECT_EQ(m.numSlices, 21);
   EXPECT_EQ(m.numRods(), 8);
   EXPECT_EQ(m.numNodes(), 8 * 21);
   EXPECT_EQ(m.numBeams(), 8 * 20);
   EXPECT_EQ(m.precrackBeams, 0);
-  EXPECT_EQ(m.precrackInterfaces, 40);
-  EXPECT_EQ(m.numInterfaces(), 20 * 21 - 40);
+  EXPECT_EQ(m.precrackLastSlice, 10);
+  EXPECT_NEAR(m.a0Eff, 10.25 * 0.3, 1e-12);
+  EXPECT_EQ(m.precrackInterfaces, 44);
+  EXPECT_EQ(m.numInterfaces(), 20 * 21 - 44);
   std::map<int, int> byTag;
   for (auto t : m.ifaceTag) ++byTag[t];
-  EXPECT_EQ(byTag[kTagPly1] + byTag[kTagPly2], 6 * 21 - 2 * 10);
-  EXPECT_EQ(byTag[kTagInterlayer12], 7 * 21 - 10);
-  EXPECT_EQ(byTag[kTagInterlayer21], 7 * 21 - 10);
+  EXPECT_EQ(byTag[kTagPly1] + byTag[kTagPly2], 6 * 21 - 2 * 11);
+  EXPECT_EQ(byTag[kTagInterlayer12], 7 * 21 - 11);
+  EXPECT_EQ(byTag[kTagInterlayer21], 7 * 21 - 11);
   EXPECT_EQ(m.topNodes.size(), 2u * 21);
   EXPECT_EQ(m.bottomNodes.size(), 2u * 21);
   // Interface areas: tributary h_e (h_e/2 in the end slices) times d/sqrt(3) for interior edges.
   double area = 0;
   for (int i = 0; i < m.numInterfaces(); ++i)
     if (m.ifaceTag[i] == kTagPly1) area += m.ifaceGeom[i].area;
-  // ply-1 in-ply edges are not clipped by the strip: 3 per slice, 2 behind the tip -> total length w_s
-  EXPECT_NEAR(area, (3 * m.w_s - 1 * (9 * 0.3 + 0.15)) / std::sqrt(3.0), 1e-9);
+  // ply-1 in-ply edges are not clipped by the strip: 3 per slice, 2 in slices 0..10 -> total length w_s
+  EXPECT_NEAR(area, (3 * m.w_s - 1 * (10 * 0.3 + 0.15)) / std::sqrt(3.0), 1e-9);
 }
 
 TEST(Geometry, PrecrackCutsRodsCrossingTheMidPlaneAtTheta30) {
@@ -183,17 +186,17 @@ TEST(Geometry, PrecrackCutsRodsCrossingTheMidPlaneAtTheta30) {
   for (int b = 0; b < m.numBeams(); ++b) {
     const Vec3& xa = m.X[m.beamNodes[b][0]];
     const Vec3& xb = m.X[m.beamNodes[b][1]];
-    const bool crosses = (xa.y() < m.yCrack) != (xb.y() < m.yCrack);
-    if (0.5 * (xa.x() + xb.x()) < m.a0) EXPECT_FALSE(crosses);
+    const bool crosses = belowCrackPlane(m, xa.y()) != belowCrackPlane(m, xb.y());
+    if (0.5 * (xa.x() + xb.x()) < m.a0Eff) EXPECT_FALSE(crosses);
     else aheadCrossing += crosses;
     EXPECT_NEAR((xb - xa).norm(), m.beamLength, kGeomTol);
   }
   EXPECT_GT(aheadCrossing, 0);
   // Every interface behind the tip stays on one side of the crack plane.
   for (int i = 0; i < m.numInterfaces(); ++i) {
-    if (m.ifaceSlice[i] * m.h_e >= m.a0) continue;
+    if (m.ifaceSlice[i] * m.h_e >= m.a0Eff) continue;
     const double yA = m.X[m.ifaceNodes[i][0]].y(), yB = m.X[m.ifaceNodes[i][1]].y();
-    EXPECT_EQ(yA < m.yCrack, yB < m.yCrack);
+    EXPECT_EQ(belowCrackPlane(m, yA), belowCrackPlane(m, yB));
   }
 }
 

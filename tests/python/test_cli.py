@@ -128,17 +128,19 @@ def test_info_prints_counts(run):
     assert r.returncode == 0, r.stderr
     out = r.stdout
     # hand count of the 6 d x 4 d specimen at h_e = 0.3 d (tests/cpp/test_geometry.cpp): 21 slices, 8 rods each
-    # in every slice, 20 interfaces per slice of which the pre-crack cuts 4 in each of slices 0..9
+    # in every slice, 20 interfaces per slice of which the pre-crack cuts 4 in each of slices 0..K, K = 10
+    # (a0 = 3 d = 10 h_e: the tip at a0_eff = 10.25 h_e, docs/model.md Geometry)
     assert info_count(out, "slices") == 21
     assert info_count(out, "rods") == 8
     assert info_count(out, "nodes") == 8 * 21
     assert info_count(out, "DOF") == 6 * 8 * 21
     assert info_count(out, "beam elements") == 8 * 20
     assert "(+0 cut by the pre-crack)" in info_line(out, "beam elements")
-    assert info_count(out, "interfaces") == 20 * 21 - 40
-    assert "(+40 cut by the pre-crack)" in info_line(out, "interfaces")
-    assert info_count(out, "ply 1") + info_count(out, "ply 2") == 6 * 21 - 2 * 10
-    assert info_count(out, "interlayer 1-2") == info_count(out, "interlayer 2-1 (periodic wrap)") == 7 * 21 - 10
+    assert info_count(out, "interfaces") == 20 * 21 - 44
+    assert "(+44 cut by the pre-crack)" in info_line(out, "interfaces")
+    assert info_line(out, "pre-crack tip").startswith("a0_eff 3.075 d") and "K = 10" in info_line(out, "pre-crack tip")
+    assert info_count(out, "ply 1") + info_count(out, "ply 2") == 6 * 21 - 2 * 11
+    assert info_count(out, "interlayer 1-2") == info_count(out, "interlayer 2-1 (periodic wrap)") == 7 * 21 - 11
     assert "bending governs" in info_line(out, "element frequency")
 
 
