@@ -134,10 +134,12 @@ struct CrackGraph {
   std::vector<Touch> touches;   // sorted by (key, elem) once built
   std::vector<double> elemX;    // x of each element
   std::vector<char> seed;       // the pre-crack's elements
-  void add(double x, bool isSeed, std::initializer_list<std::pair<int, int>> pts) {
+  std::vector<char> offPlane;   // a failed interface whose two rods lie on one side of the crack plane (a kink)
+  void add(double x, bool isSeed, std::initializer_list<std::pair<int, int>> pts, bool kink = false) {
     const int id = static_cast<int>(elemX.size());
     elemX.push_back(x);
     seed.push_back(isSeed);
+    offPlane.push_back(kink);
     for (auto [rod, slice] : pts) touches.push_back({static_cast<long>(rod) * numSlices + slice, id});
   }
 };
@@ -154,7 +156,9 @@ CrackGraph collectCrackElements(const Model& m, const cohesive::Law& law, const 
   for (int i = 0; i < m.numInterfaces(); ++i) {
     if (!cohesive::isFailed(law, s.lambdaMax[i])) continue;
     const int k = m.ifaceSlice[i];
-    g.add(k * m.h_e, false, {{m.nodeRod[m.ifaceNodes[i][0]], k}, {m.nodeRod[m.ifaceNodes[i][1]], k}});
+    const int a = m.ifaceNodes[i][0], b = m.ifaceNodes[i][1];
+    const bool kink = belowCrackPlane(m, m.X[a].y()) == belowCrackPlane(m, m.X[b].y());
+    g.add(k * m.h_e, false, {{m.nodeRod[a], k}, {m.nodeRod[b], k}}, kink);
   }
   for (int e = 0; e < m.numBeams(); ++e) {
     if (!s.beamBroken[e]) continue;
@@ -167,8 +171,8 @@ CrackGraph collectCrackElements(const Model& m, const cohesive::Law& law, const 
   return g;
 }
 
-// The largest x of the elements connected to the pre-crack (depth-first from its elements).
-double farthestConnectedX(const CrackGraph& g) {
+// Which elements are connected to the pre-crack (depth-first from its elements).
+std::vector<char> connectedToPrecrack(const CrackGraph& g) {
   const int ns = g.numSlices;
   std::vector<std::vector<int>> elemTouches(g.elemX.size());
   for (const auto& t : g.touches) elemTouches[t.elem].push_back(static_cast<int>(t.key));
@@ -183,11 +187,9 @@ double farthestConnectedX(const CrackGraph& g) {
   std::vector<int> stack;
   for (std::size_t i = 0; i < g.elemX.size(); ++i)
     if (g.seed[i]) { visited[i] = 1; stack.push_back(static_cast<int>(i)); }
-  double maxX = 0;
   while (!stack.empty()) {
     const int e = stack.back();
     stack.pop_back();
-    maxX = std::max(maxX, g.elemX[e]);
     for (int key : elemTouches[e]) {
       const int slice = key % ns;
       for (int dk = -1; dk <= 1; ++dk) {
@@ -198,13 +200,30 @@ double farthestConnectedX(const CrackGraph& g) {
       }
     }
   }
-  return maxX;
+  return visited;
+}
+
+CrackCluster summariseCluster(const Model& m, const CrackGraph& g) {
+  const std::vector<char> connected = connectedToPrecrack(g);
+  double maxX = 0;
+  CrackCluster c;
+  for (std::size_t e = 0; e < connected.size(); ++e) {
+    if (!connected[e]) continue;
+    maxX = std::max(maxX, g.elemX[e]);
+    c.offPlaneInterfaces += g.offPlane[e];
+  }
+  c.advance = std::max(0.0, maxX - m.a0Eff);
+  return c;
 }
 
 }  // namespace
 
+CrackCluster measureCrackCluster(const Model& m, const cohesive::Law& law, const State& s) {
+  return summariseCluster(m, collectCrackElements(m, law, s));
+}
+
 double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State& s) {
-  return std::max(0.0, farthestConnectedX(collectCrackElements(m, law, s)) - m.a0Eff);
+  return measureCrackCluster(m, law, s).advance;
 }
 
 double computeGripLoad(const Operators& ops, const State& s) {

@@ -48,6 +48,15 @@ double computeJ(const Model& m, const Materials& mat, const Operators& ops, cons
 /// through either ply and the interlayers, kinked or deflected off the mid-plane.
 double measureCrackAdvance(const Model& m, const cohesive::Law& law, const State& s);
 
+/// The crack's cluster (failed interfaces and deleted rod elements connected to the pre-crack, docs/model.md):
+/// its advance (as measureCrackAdvance) and how many of its failed interfaces join two rods on one side of the
+/// crack plane: the kinks along the rods, which the paper sees form before any rod breaks (docs/results.md).
+struct CrackCluster {
+  double advance = 0;          // Delta a (d)
+  int offPlaneInterfaces = 0;  // failed interfaces of the cluster off the crack plane
+};
+CrackCluster measureCrackCluster(const Model& m, const cohesive::Law& law, const State& s);
+
 /// The generalised force conjugate to U: sum of F_y x shape over the prescribed DOFs.
 double computeGripLoad(const Operators& ops, const State& s);
 

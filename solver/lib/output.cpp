@@ -79,6 +79,9 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"broken_rod_elements", &M::brokenBeams, "count"},
       {"failed_interfaces", &M::failedInterfaces, "count"},
       {"inelastic_interfaces", &M::inelasticInterfaces, "count"},
+      {"kinked_interfaces", &M::kinkedInterfaces, "count",
+       "failed interfaces of the crack's cluster (connected to the pre-crack) whose two rods lie on one side of the "
+       "crack plane: kinks along the rods, against failed interfaces across the plane"},
       {"rate_multiplier", &M::rateMultiplier, "-",
        "phi: the adaptive loading rate's multiplier of v_app (dU/dt = phi U'(tau); 1 when rate_adapt_max = 1)"},
       {"inelastic_reach_over_d", &M::inelasticReach, "d",

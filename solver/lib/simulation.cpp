@@ -196,6 +196,7 @@ Measurement Simulation::measure() const {
   r.brokenBeams = state.brokenBeams();
   r.failedInterfaces = countFailedInterfaces();
   r.inelasticInterfaces = countInelasticInterfaces();
+  r.kinkedInterfaces = measureCrackCluster(model, materials.law, state).offPlaneInterfaces;
   r.inelasticReach = inelasticReach();
   r.load = computeGripLoad(ops, state);
   return r;

@@ -24,6 +24,7 @@ struct Measurement {
   double kinetic = 0, kineticBeyond = 0, strainBeams = 0, strainInterfaces = 0, damping = 0, fracture = 0, rodFracture = 0;
   double external = 0, balanceError = 0;
   int brokenBeams = 0, failedInterfaces = 0, inelasticInterfaces = 0;
+  int kinkedInterfaces = 0;  // failed interfaces of the crack's cluster off the crack plane (CrackCluster)
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)
   double rateMultiplier = 1;  // phi of the adaptive loading rate (loading_rate.hpp; 1 when off)
   double inelasticReach = 0;  // largest |y - y_crack| of an inelastic interface or broken rod element (d)

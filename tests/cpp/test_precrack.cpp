@@ -253,3 +253,33 @@ TEST(CrackAdvance, DaughterCrackCountsOnlyOnceJoined) {
     EXPECT_NEAR(f.advance(), (K + 16) * f.m.h_e - f.m.a0Eff, 1e-12) << "theta " << theta;
   }
 }
+
+// The cluster's kinks: failed interfaces of the crack joining two rods on one side of the crack plane. A straight
+// crack across the plane has none; a crack kinked along the rods has one per slice of the kink in the band (the
+// bands between ply-1 rods -1 and 0 cross the plane at the crisscross, so only those past it count); a kink that is
+// not joined to the pre-crack counts nothing.
+TEST(CrackAdvance, KinksAreTheClustersFailedInterfacesOffThePlane) {
+  CrackFixture f(30);
+  const int K = f.m.precrackLastSlice;
+  EXPECT_EQ(measureCrackCluster(f.m, f.law, f.s).offPlaneInterfaces, 0);
+  for (int k = K + 1; k <= K + 4; ++k) f.failMidPlane(k);
+  CrackCluster c = measureCrackCluster(f.m, f.law, f.s);
+  EXPECT_EQ(c.offPlaneInterfaces, 0);
+  EXPECT_NEAR(c.advance, f.advance(), 0);
+  CrackFixture g(30);
+  int offPlane = 0;
+  for (int k = K + 1; k <= K + 20; ++k) {
+    g.failBand(k, 0, -1);
+    const int a = rodOf(g.m, 0, -1);
+    for (int i = 0; i < g.m.numInterfaces(); ++i)
+      if (g.m.ifaceSlice[i] == k && g.s.lambdaMax[i] > 0 && (g.m.nodeRod[g.m.ifaceNodes[i][0]] == a ||
+                                                             g.m.nodeRod[g.m.ifaceNodes[i][1]] == a))
+        offPlane += belowCrackPlane(g.m, g.m.X[g.m.ifaceNodes[i][0]].y()) ==
+                    belowCrackPlane(g.m, g.m.X[g.m.ifaceNodes[i][1]].y());
+  }
+  ASSERT_GT(offPlane, 10);
+  EXPECT_EQ(measureCrackCluster(g.m, g.law, g.s).offPlaneInterfaces, offPlane);
+  CrackFixture apart(30);  // the same kink 10 slices ahead, with nothing joining it
+  for (int k = K + 10; k <= K + 20; ++k) apart.failBand(k, 0, -1);
+  EXPECT_EQ(measureCrackCluster(apart.m, apart.law, apart.s).offPlaneInterfaces, 0);
+}

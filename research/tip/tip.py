@@ -1,0 +1,133 @@
+"""The tip-reading identification (README.md here): its runs, their records and the report.
+
+    python3 -m research.tip.tip run NAME --size 80 --G 10 --reading intact --phase 0     # run (resumable), record
+    python3 -m research.tip.tip record NAME                                            # record a finished run
+    python3 -m research.tip.tip report                                                 # the runs table, from data/
+
+A run goes to runs/tip/NAME (niced, one thread, checkpointed); its record to data/NAME.json: the case, the keys of
+the candidate, the metrics the rule reads (R_init, the (0,30] and (5,25] means, the first rod break and the kinks
+before it, statements (i) and (ii)) and the R-curve to 10 digits, so that the report needs no run folder.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+from bench import records
+from enamel_results import metrics, paths, results
+
+HERE = pathlib.Path(__file__).resolve().parent
+DATA = HERE / "data"
+RUNS = paths.RUNS / "tip"
+CASE = paths.case_file("theta30_s21.4_e10_cv0")
+PRESET = "converged"
+
+
+def solver_args(binary: str, a: argparse.Namespace, out: pathlib.Path) -> list[str]:
+    sets = [f"w_s_over_d={a.size}", f"h_s_over_d={a.size}", f"Gamma_k_over_sigma0sq={a.G}",
+            f'crisscross_at_tip="{a.reading}"', f"crisscross_phase={a.phase}", "threads=1"]
+    args = ["nice", "-n", "19", binary, "run", str(CASE), "--preset", PRESET, "--out", str(out), "--resume",
+            "--quiet", "--checkpoint-every", "300"]
+    for s in sets:
+        args += ["--set", s]
+    return args
+
+
+def first_events(h5: pathlib.Path) -> dict:
+    """The first rod break (Delta_a at the first history row with a broken rod element), the crack's advance and
+    its kinks off the crack plane (history kinked_interfaces) at the row before it, and the threshold of statement
+    (i): the first crisscross point at or ahead of the tip whose rods are intact, minus a0_eff, minus h_e."""
+    with h5py.File(h5, "r") as f:
+        h, g = f["history"], f["geometry"].attrs
+        rods, da, kinks = (np.asarray(h[k]) for k in ("broken_rod_elements", "da_over_d", "kinked_interfaces"))
+        a0, xc, he = float(g["a0_effective"]), float(g["x_crisscross"]), float(g["h_e"])
+        theta = math.radians(float(g["theta_D_deg"]))
+    spacing = 1.0 / math.sin(theta)
+    first_intact = xc + math.ceil((a0 - he / 4 - xc) / spacing) * spacing   # crossing at or past slice K
+    i = int(np.argmax(rods > 0)) if (rods > 0).any() else None
+    return dict(first_break_da=None if i is None else float(da[i]),
+                da_before_first_break=None if i is None else float(da[max(i - 1, 0)]),
+                kinks_before_first_break=None if i is None else int(kinks[max(i - 1, 0)]),
+                threshold_da=first_intact - a0 - he)
+
+
+def statements(rec: dict) -> dict:
+    c = metrics.RCurve.of(rec["da"], rec["R"], broken_rods=rec["broken_rods"])
+    m525 = metrics.advance_mean(c, 5, 25)
+    ev = rec["events"]
+    kinks_first = ev["first_break_da"] is None or (ev["da_before_first_break"] > 0
+                                                    and ev["first_break_da"] >= ev["threshold_da"])
+    return dict(mean_0_30=metrics.advance_mean(c, 0, 30), mean_5_25=m525, i_kinks_first=bool(kinks_first),
+                ii_rising=bool(rec["R_init"] <= 0.8 * m525))
+
+
+def record(name: str, out: pathlib.Path, keys: dict | None = None) -> dict:
+    h5 = results.load_result(out / "result.h5").path
+    rec = records.record_of(h5, name)
+    rec["keys"] = keys or json.loads((DATA / f"{name}.json").read_text())["keys"]
+    rec["cpu"] = records.cpu_model()
+    rec["events"] = first_events(h5)
+    rec["statements"] = statements(rec)
+    DATA.mkdir(exist_ok=True)
+    (DATA / f"{name}.json").write_text(json.dumps(rec, indent=1))
+    return rec
+
+
+def report() -> str:
+    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    lines = ["| run | size | G | reading | phase | status | R_init | mean (0,30] | mean (5,25] | first break (d) |"
+             " Delta_a before it | kinks off the plane | threshold (d) | (i) | (ii) | wall (h) |", "|" + "---|" * 16]
+    for r in recs:
+        k, e, s = r["keys"], r["events"], r["statements"]
+        fb = "none" if e["first_break_da"] is None else f"{e['first_break_da']:.2f}"
+        kb = "-" if e["kinks_before_first_break"] is None else str(e["kinks_before_first_break"])
+        db = "-" if e["da_before_first_break"] is None else f"{e['da_before_first_break']:.2f}"
+        lines.append(f"| {r['name']} | {k['size']} | {k['G']:g} | {k['reading']} | {k['phase']:g} | "
+                     f"{r['meta'].get('status')} | {r['R_init']:.2f} | {s['mean_0_30']:.2f} | {s['mean_5_25']:.2f} | "
+                     f"{fb} | {db} | {kb} | {e['threshold_da']:.2f} | {'holds' if s['i_kinks_first'] else 'fails'} | "
+                     f"{'holds' if s['ii_rising'] else 'fails'} | {r['meta'].get('wall_time_s', math.nan) / 3600:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python3 -m research.tip.tip", description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    run = sub.add_parser("run", help="run one candidate (resumable) and record it")
+    run.add_argument("name")
+    run.add_argument("--size", type=int, required=True)
+    run.add_argument("--G", type=float, required=True)
+    run.add_argument("--reading", choices=("intact", "cut"), required=True)
+    run.add_argument("--phase", type=float, default=0.0)
+    run.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
+    rec = sub.add_parser("record", help="record a finished run of runs/tip/NAME")
+    rec.add_argument("name")
+    sub.add_parser("report", help="the runs table from data/")
+    a = ap.parse_args(argv)
+    if a.cmd == "report":
+        print(report(), end="")
+        return 0
+    out = RUNS / a.name
+    if a.cmd == "record":
+        record(a.name, out)
+        return 0
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "log.txt", "a") as log:
+        rc = subprocess.run(solver_args(a.binary, a, out), stderr=log).returncode
+    if rc != 0:
+        print(f"tip: {a.name} exited with status {rc} (log: {out / 'log.txt'})", file=sys.stderr)
+        return rc
+    r = record(a.name, out, dict(size=a.size, G=a.G, reading=a.reading, phase=a.phase))
+    print(f"{a.name}: {r['statements']}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
