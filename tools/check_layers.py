@@ -16,14 +16,14 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 # Lowest first. A file's layer is that of its name (foo.hpp and foo.cpp share one).
 LAYERS = [
     ("base", ["version", "exit_codes", "errors", "git_hash", "file_io"]),
-    ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params", "resources"]),
+    ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params"]),
     ("geometry", ["geometry", "far_field"]),
     ("plain data", ["state"]),
     ("loops over the data", ["kernels", "node_blocks", "loading_rate", "measurements", "static_solve"]),
     ("schemes and set-up", ["integrators", "integrators/step_parts", "integrators/node_rows",
                             "integrators/slice_outputs", "integrators/newmark", "integrators/lumped",
                             "integrators/schemes", "integrators/registry", "setup"]),
-    ("the simulation", ["simulation"]),
+    ("the simulation", ["simulation", "resources"]),   # resources: estimates from blocks of the case's model
     ("files and tools", ["output", "checkpoint", "profile"]),
     ("the run", ["runner"]),
     ("the command line", ["enamel_dem"]),
