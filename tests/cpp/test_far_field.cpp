@@ -14,19 +14,11 @@
 #include "kernels.hpp"
 #include "simulation.hpp"
 
+#include "specimen.hpp"
+
 using namespace enamel;
 
 namespace {
-
-GeometryParams geometry(double theta, double w, double h) {
-  GeometryParams g;
-  g.theta_deg = theta;
-  g.w_s = w;
-  g.h_s = h;
-  g.a0 = 0.5 * w;
-  g.h_e = 0.3;
-  return g;
-}
 
 // E_transverse given (not measured) to keep the set-up short.
 CaseParams caseWith(const std::string& extra) {
@@ -39,7 +31,7 @@ CaseParams caseWith(const std::string& extra) {
 
 TEST(FarField, WideBandIsTheFullModel) {
   for (double theta : {0.0, 30.0}) {
-    const Model full = buildCrossply(geometry(theta, 12, 8));
+    const Model full = buildCrossply(specimen(theta, 12, 8));
     const Model same = coarsenFarField(full, 4, 4.0 + 1e-9 + 0.5 * full.h_s);
     EXPECT_FALSE(same.hasFarField());
     ASSERT_EQ(same.numNodes(), full.numNodes());
@@ -64,7 +56,7 @@ TEST(FarField, WideBandIsTheFullModel) {
 // grips and the pre-crack's cut as in the full model, and fewer nodes and interfaces.
 TEST(FarField, LumpedModelKeepsAreaRodsGripsAndRigidMotion) {
   for (double theta : {0.0, 30.0}) {
-    const Model full = buildCrossply(geometry(theta, 24, 24));
+    const Model full = buildCrossply(specimen(theta, 24, 24));
     const Model red = coarsenFarField(full, 4, 3.0);
     ASSERT_TRUE(red.hasFarField());
     EXPECT_LT(red.numNodes(), 0.6 * full.numNodes()) << theta;

@@ -12,6 +12,8 @@
 #include "measurements.hpp"
 #include "state.hpp"
 
+#include "specimen.hpp"
+
 using namespace enamel;
 
 namespace {
@@ -35,16 +37,6 @@ RemovedSet removedSet(const Model& m) {
     r.interfaces.insert({m.rodPly[a], m.rodIndex[a], m.rodPly[b], m.rodIndex[b], m.precrackIfaceSlice[c]});
   }
   return r;
-}
-
-GeometryParams sizeParams(double thetaDeg, double w, double h) {
-  GeometryParams p;
-  p.theta_deg = thetaDeg;
-  p.w_s = w;
-  p.h_s = h;
-  p.a0 = 0.5 * w;
-  p.h_e = 0.3;
-  return p;
 }
 
 int rodOf(const Model& m, int ply, int j) {
@@ -74,7 +66,7 @@ TEST(Precrack, RemovedSetDoesNotMoveWithA0OrHeByAHair) {
   const double hair = 1e-9;
   for (auto [w, h] : {std::pair{16.0, 8.0}, std::pair{80.0, 80.0}})
     for (double theta : {0.0, 15.0, 30.0}) {
-      const GeometryParams base = sizeParams(theta, w, h);
+      const GeometryParams base = specimen(theta, w, h);
       const Model m0 = buildCrossply(base);
       const RemovedSet r0 = removedSet(m0);
       ASSERT_FALSE(r0.interfaces.empty());
@@ -108,7 +100,7 @@ TEST(Precrack, TipIsTheQuarterPointAfterTheLastCutSlice) {
   EXPECT_EQ(precrackTip(3.0 - 1e-3, 0.3).lastSlice, 9);
   EXPECT_EQ(precrackTip(3.1, 0.3).lastSlice, 10);
   for (double theta : {0.0, 30.0}) {
-    const Model m = buildCrossply(sizeParams(theta, 16, 8));
+    const Model m = buildCrossply(specimen(theta, 16, 8));
     const int K = m.precrackLastSlice;
     EXPECT_NEAR(m.a0Eff, (K + 0.25) * m.h_e, 1e-12);
     EXPECT_LE(std::abs(m.a0Eff - m.a0), 0.75 * m.h_e);
@@ -133,7 +125,7 @@ TEST(Precrack, TipIsTheQuarterPointAfterTheLastCutSlice) {
 // shifts the lattice by its fraction of d/sin(theta) from the reading's origin.
 TEST(Precrack, CrisscrossAtTipIntactOrCut) {
   for (double theta : {15.0, 30.0}) {
-    GeometryParams p = sizeParams(theta, 30, 10);
+    GeometryParams p = specimen(theta, 30, 10);
     const Model intact = buildCrossply(p);
     p.crisscrossCutAtTip = true;
     const Model cut = buildCrossply(p);
@@ -176,7 +168,7 @@ struct CrackFixture {
   Model m;
   cohesive::Law law;
   State s;
-  explicit CrackFixture(double theta) : m(buildCrossply(sizeParams(theta, 30, 16))) {
+  explicit CrackFixture(double theta) : m(buildCrossply(specimen(theta, 30, 16))) {
     law = cohesive::makeLaw(0.1, 0.01, 0.01 * 0.01 / 0.1 * 10, 1, 1);
     s.lambdaMax.assign(m.numInterfaces(), 0.0);
     s.beamBroken.assign(m.numBeams(), 0);
