@@ -221,8 +221,7 @@ def speed_error_rows(jobs: list[Job]) -> list[dict]:
             rows.append(row)
             continue
         threads = int(m["threads"])
-        same = (metrics.same_rcurve(metrics.RCurve.of(ref.da, ref.R, broken_rods=ref.broken_rods),
-                                    metrics.RCurve.of(r.da, r.R, broken_rods=r.broken_rods), metrics.TOL_RATE_SPEED)
+        same = (metrics.same_rcurve(metrics.rcurve_of(ref), metrics.rcurve_of(r), metrics.TOL_RATE_SPEED)
                 if r.da.size > 1 and ref.da.size > 1 else None)
         row.update(peak_memory_mb=m["peak_memory_mb"],
             status=r.status, integrator=m["integrator"], threads=threads, dt=m["dt"], steps=int(m["steps"]),

@@ -61,6 +61,11 @@ class RCurve:
         return self.broken_rods if self.da[-1] - hi <= TOTAL_COUNTS_WITHIN_OVER_D else None
 
 
+def rcurve_of(result) -> RCurve:
+    """The R-curve of a loaded result (results.Result), with its broken rod elements up to its last point."""
+    return RCurve.of(result.da, result.R, broken_rods=result.broken_rods)
+
+
 def advance_mean(c: RCurve, lo: float, hi: float) -> float:
     """R averaged over crack advance over (lo, hi]: the integral of the piecewise-linear R(Delta_a) over the part
     of (lo, hi] the curve covers, divided by that length (nan when it covers none)."""

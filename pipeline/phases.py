@@ -78,14 +78,10 @@ def load_phases(root: pathlib.Path, n: int) -> dict[int, results.Result]:
     return done
 
 
-def curve_of(r: results.Result) -> metrics.RCurve:
-    return metrics.RCurve.of(r.da, r.R, broken_rods=r.broken_rods)
-
-
 def phase_rows(done: dict[int, results.Result], n: int) -> list[dict]:
     rows = []
     for k, r in sorted(done.items()):
-        c = curve_of(r)
+        c = metrics.rcurve_of(r)
         rows.append(dict(phase=f"{k}/{n}", R_init=float(r.R[0]), mean_0_30=metrics.advance_mean(c, 0, 30),
                          mean_5_25=metrics.advance_mean(c, 5, 25), first_break=r.da_first_rod_fracture,
                          rods=r.broken_rods, da_max=r.da_max))
@@ -159,7 +155,7 @@ def report(root: pathlib.Path, case: pathlib.Path, preset: str, sets: list[str],
     rows = phase_rows(done, n)
     if len(done) >= 2:
         labels = [f"{k}/{n}" for k in sorted(done)]
-        avg = metrics.phase_average([curve_of(done[k]) for k in sorted(done)])
+        avg = metrics.phase_average([metrics.rcurve_of(done[k]) for k in sorted(done)])
         rows.append(average_row(avg))
         write_csv(root / "phase_average.csv", avg, labels)
         plot(root / "phase_average.png", avg, labels, f"{case.stem}, preset {preset}, {n} phases")

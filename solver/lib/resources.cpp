@@ -45,7 +45,7 @@ ResourceEstimate estimateResources(const CaseParams& p) {
 
 namespace {
 // Time of a run (estimateRunTime). Measured with the build of commit c09beab on 2026-12-06, one thread, on this
-// project's development machine (AMD EPYC, AVX-512; 2 cores shared by several sessions, load 10-16: wall times
+// project's development machine (AMD EPYC, AVX-512; 2 cores under other builds and runs, load 10-16: wall times
 // swing, so rates are CPU (user) seconds, and the constants take the slow side), with
 //   /usr/bin/time enamel-dem run paper_cases/CASE.toml --preset P --set threads=1 [--set max_steps=N ...]
 // and the run's /meta and /history.
