@@ -181,7 +181,8 @@ def run_row(out: pathlib.Path) -> dict:
     r = results.load_result(out / paths.RESULT_NAMES["completed"])
     return dict(core_s=sum(p["cpu_s"] for p in pieces), wall_s=sum(p["wall_s"] for p in pieces),
                 pieces=len(pieces), steps=int(r.meta["steps"]), dof=int(r.meta["dof"]), threads=int(r.meta["threads"]),
-                git=str(r.meta["git_hash"]), G=r.param(run_bench.G_KEY), machines=sorted({p["machine"] for p in pieces}),
+                git=str(r.meta["git_hash"]), G=r.param(run_bench.G_KEY),
+                machines=sorted({p["machine"] for p in pieces}),
                 started_utc=pieces[0]["started_utc"] if pieces else "", result=r)
 
 
@@ -243,7 +244,8 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"(0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
          f"pointwise L2 reported, not deciding. Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
          "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | steps (baseline / new) "
-         "| DOF | R mean over (0, hi] d: baseline / new (diff) | R_init diff | broken rods | L2 | same R-curve | verdict |",
+         "| DOF | R mean over (0, hi] d: baseline / new (diff) | R_init diff | broken rods | L2 | same R-curve "
+         "| verdict |",
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if r.get("status") != "complete":
