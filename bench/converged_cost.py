@@ -51,6 +51,9 @@ RUNS = bench.RUNS / "converged_cost"
 TABLE = "converged_cost"             # OUT/converged_cost.md and .csv
 RECORD = "cost.json"                 # in each run's folder: its command and pieces
 CHECKPOINT_EVERY_S = 300.0
+# One thread a run, the static start's factorisation included: CHOLMOD's BLAS (OpenBLAS's pthread build) would
+# otherwise start a thread per core. Set for every solver the harness starts, baseline and new alike.
+ONE_THREAD_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
 # ------------------------------------------------------------------------------------------------ solvers
@@ -236,7 +239,8 @@ def markdown(rows: list[dict], header: dict) -> str:
     check = "" if header["preset"] == PRESET else f" -- a `{header['preset']}`-preset check, not the converged table"
     L = [f"# A converged run's cost: {header['baseline']} against {header['new']}{check}", "",
          f"{header['date']} UTC; {header['machine']}; preset `{header['preset']}`{header['both_sets']}; G = "
-         f"{header['G']}; 1 thread a run, {header['jobs']} runs at once{header['nice']}; `make bench-converged` "
+         f"{header['G']}; 1 thread a run (threads=1, {' '.join(f'{k}=1' for k in ONE_THREAD_ENV)}), "
+         f"{header['jobs']} runs at once{header['nice']}; `make bench-converged` "
          f"(bench/converged_cost.py). Baseline: the build of {header['baseline']} (solver {header['baseline_git']}). "
          f"New: solver {header['new_git']}{header['new_sets']}. Core-seconds: the solver process's CPU time "
          f"(user + system) summed over its pieces; ratio = baseline / new = fewer steps x cheaper step (core-s per "
@@ -331,6 +335,7 @@ def main(argv=None) -> int:
         for v in (base, new):
             shutil.rmtree(a.runs / a.preset / v.label, ignore_errors=True)
     if not a.report_only:
+        os.environ.update(ONE_THREAD_ENV)   # the solvers inherit it
         try:
             run_all([base, new], a.cases, a.preset, a.runs, a.jobs, a.nice, a.checkpoint_every)
         except KeyboardInterrupt as e:
