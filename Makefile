@@ -20,8 +20,12 @@
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
 #   make bench          speed against error of every integrator and knob, and cost growth, in one run (~100 min on
-#                       2 cores; its cases at G = 3, set in bench/run_bench.py): bench/results.csv,
-#                       bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#                       2 cores at G = 3; at the solver's default G, which the report's header names, or
+#                       BENCH_G=3): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
+#                       cases at the `converged` preset to Delta_a = 30 d, each by c09beab's build (built once in
+#                       build/baseline-c09beab/) and by build/enamel-dem with CONVERGED_SET, one thread a run, JOBS
+#                       at once, resumable (6 runs of 23-37 min at c09beab's speed): bench/converged_cost.md, .csv
 #   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate
@@ -78,7 +82,7 @@ endif
 FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
-.PHONY: bench bench-step bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all \
+.PHONY: bench bench-converged bench-step bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all \
   vtk reference clean-runs check-preset slurm
 
 help:
@@ -116,7 +120,14 @@ clean:
 	rm -rf $(BUILD_DIR)
 
 bench: $(ENAMEL)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS) \
+	  $(if $(BENCH_G),--G $(BENCH_G))
+
+# A converged run's cost: c09beab's build against this one (or CONVERGED_SET on it), the same R-curve decided by
+# enamel_results.metrics.same_rcurve. CONVERGED_ARGS passes more options (bench/converged_cost.py --help).
+bench-converged: $(ENAMEL)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.converged_cost --jobs $(JOBS) \
+	  $(foreach s,$(CONVERGED_SET),--set '$(s)') $(CONVERGED_ARGS)
 
 # Instructions and cache misses per kernel, per interface and per node (valgrind callgrind; independent of how
 # busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.

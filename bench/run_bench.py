@@ -4,7 +4,8 @@
 Everything is measured in ONE run of this script, so that every ratio compares runs made on the same
 machine in the same state:
 
-1. Speed against error. Each bench case runs at the `reduced` preset with the reference scheme (`paper` at
+1. Speed against error. Each bench case runs at the `reduced` preset, at the solver's default interface fracture
+   energy G (or --G; the report's header names it), with the reference scheme (`paper` at
    the preset's loading rate, the slowest rate measured here) and with every fast variant (integrator and
    knobs: time-step factor, stiffness-damping cap, loading rate, threads). For each run: wall time (the whole
    process, set-up included), CPU time, steps, DOF, DOF-updates per second per core, peak memory, and the
@@ -52,11 +53,37 @@ ERROR_BOUND = metrics.TOL_RATE_SPEED   # the measure's tolerance for speed check
 PRESET = "reduced"
 CASES = ["theta30_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1"]
 REFERENCE = "paper"
-# The physics the speed-against-error and cost runs use beyond their case files: the interface fracture energy of
-# the bench's rows since 2026-11-23 (G = Gamma_i k / sigma0^2 = 3), set here so that a change of the solver's
-# default (10 since 6008856) does not change what the bench measures. At G = 10 its `paper` references take ~2 h
-# each (2026-12-05). The kernel profile keeps the default, as `make bench-paper` and bench.profile_pair step it.
-BENCH_PHYSICS = {"Gamma_k_over_sigma0sq": 3}
+# The physics the speed-against-error and cost runs use beyond their case files: the interface fracture energy
+# G = Gamma_i k / sigma0^2 (case key G_KEY), the solver's default unless --G names another, set explicitly on every
+# run and named in the report's header (bench_physics). The bench measured at G = 3 from 2026-11-23 to 2026-12-05,
+# the default before 6008856 (bench/README.md keeps those rows as history); at G = 10 its `paper` references take
+# ~2 h each. The kernel profile steps at the default, as `make bench-paper` and bench.profile_pair do.
+G_KEY = "Gamma_k_over_sigma0sq"
+BENCH_PHYSICS = {}   # set by main(): {G_KEY: G}
+
+
+def key_defaults(keys_markdown: str) -> dict:
+    """{key: default (text)} from `enamel-dem keys` (a Markdown table: | `key` | kind | default | range | ...)."""
+    out = {}
+    for line in keys_markdown.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) >= 3 and cells[0].startswith("`") and cells[0].endswith("`"):
+            out[cells[0].strip("`")] = cells[2]
+    return out
+
+
+def solver_default(key: str, binary=None) -> float:
+    """The solver's default of a numeric case key, as `enamel-dem keys` lists it (one definition: the solver's)."""
+    proc = subprocess.run([str(binary or solver()), "keys"], capture_output=True, text=True, check=True)
+    defaults = key_defaults(proc.stdout)
+    if key not in defaults:
+        raise KeyError(f"`enamel-dem keys` lists no key {key}")
+    return float(defaults[key])
+
+
+def bench_physics(G: float | None = None, binary=None) -> dict:
+    """The physics keys every speed-against-error and cost run sets: G as given, else the solver's default."""
+    return {G_KEY: G if G is not None else solver_default(G_KEY, binary)}
 
 # Variants: name -> (--set overrides, threads). `paper` is the reference. dt_factor is dt over the smallest
 # period of the integrator's own system (lumped: stable up to ~0.187 with damping_cap 1, ~0.236 with 0.5).
@@ -133,6 +160,7 @@ class Job:
     wall_s: float = math.nan
     cpu_s: float = math.nan
     returncode: int = -1
+    pid: int = 0             # while it runs
 
     @property
     def key(self) -> str:
@@ -155,40 +183,55 @@ def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path, fla
     return a
 
 
-def run_jobs(jobs: list[Job], cores: int, log=print) -> None:
+def run_jobs(jobs: list[Job], cores: int, log=print, on_done=None, stop=None, log_mode="w") -> None:
     """Run the jobs, longest first, never using more than `cores` cores; records wall, CPU and peak memory of
     each (os.wait4 gives the child's own CPU time; its maxrss would count the forking Python's pages, so peak
-    memory comes from the solver's /meta/peak_memory_mb)."""
+    memory comes from the solver's /meta/peak_memory_mb). on_done(job) is called as each ends; once stop()
+    is true no further job starts (those running are waited for). Each job's output goes to OUT/bench.log,
+    opened with log_mode ("a": a resumed run keeps the log of its earlier pieces)."""
     pending = sorted(jobs, key=lambda j: -j.expected_s)
     running = {}   # pid -> (job, start, popen)
     free = cores
     t_all = time.perf_counter()
-    while pending or running:
+    while running or (pending and not (stop and stop())):
         started = True
-        while started:
+        while started and not (stop and stop()):
             started = False
             for j in pending:
                 if j.cores <= free or (not running and j.cores > cores):
                     j.out.mkdir(parents=True, exist_ok=True)
-                    logf = open(j.out / "bench.log", "w")
-                    p = subprocess.Popen(j.args, stdout=logf, stderr=subprocess.STDOUT)
-                    logf.close()
+                    with open(j.out / "bench.log", log_mode) as logf:
+                        p = subprocess.Popen(j.args, stdout=logf, stderr=subprocess.STDOUT)
+                    j.pid = p.pid
                     running[p.pid] = (j, time.perf_counter(), p)
                     free -= j.cores
                     pending.remove(j)
                     started = True
                     break
+        if not running:
+            break
         pid, status, ru = os.wait4(-1, 0)
         if pid not in running:
             continue
         j, t0, p = running.pop(pid)
         p.returncode = os.waitstatus_to_exitcode(status)
-        j.returncode = p.returncode
+        j.returncode, j.pid = p.returncode, 0
         j.wall_s = time.perf_counter() - t0
         j.cpu_s = ru.ru_utime + ru.ru_stime
         free += j.cores
         log(f"[{time.perf_counter() - t_all:7.0f} s] {j.key}: exit {j.returncode}, {j.wall_s:.1f} s wall, "
             f"{j.cpu_s:.1f} s CPU")
+        if on_done:
+            on_done(j)
+
+
+def speed_comparison(ref, r) -> metrics.Comparison | None:
+    """Result r against reference ref by "the same R-curve" at the rate-and-speed tolerance (metrics.same_rcurve
+    with TOL_RATE_SPEED: R averaged over (0,30] d and R_init within 2%, broken rods within 20%); None when
+    either curve has fewer than two points."""
+    if r.da.size < 2 or ref.da.size < 2:
+        return None
+    return metrics.same_rcurve(metrics.rcurve_of(ref), metrics.rcurve_of(r), metrics.TOL_RATE_SPEED)
 
 
 # ------------------------------------------------------------------------------------------- speed vs error
@@ -221,8 +264,7 @@ def speed_error_rows(jobs: list[Job]) -> list[dict]:
             rows.append(row)
             continue
         threads = int(m["threads"])
-        same = (metrics.same_rcurve(metrics.rcurve_of(ref), metrics.rcurve_of(r), metrics.TOL_RATE_SPEED)
-                if r.da.size > 1 and ref.da.size > 1 else None)
+        same = speed_comparison(ref, r)
         row.update(peak_memory_mb=m["peak_memory_mb"],
             status=r.status, integrator=m["integrator"], threads=threads, dt=m["dt"], steps=int(m["steps"]),
             dof=int(m["dof"]), stepping_s=m["wall_time_s"],
@@ -396,9 +438,9 @@ def fmt(v, spec=".3g"):
 
 
 def summary_markdown(rows, crows, header: dict) -> str:
-    L = [f"# Bench results ({header['date']})", "",
+    L = [f"# Bench results ({header['date']}, G = {header['G']:g})", "",
          f"Machine: {header['machine']}. Solver {header['git']}. Preset `{header['preset']}`, "
-         f"{', '.join(f'{k} = {v}' for k, v in BENCH_PHYSICS.items())}; "
+         f"G = {G_KEY} = {header['G']:g} ({header['G_source']}); "
          f"{header['jobs']} runs at a time; whole bench {header['total_min']:.0f} min. "
          f"Reference: `{REFERENCE}` at the preset's rate (the slowest measured). "
          f"Bound: the same R-curve as the reference (`enamel_results.metrics.same_rcurve`: R averaged over crack "
@@ -476,7 +518,7 @@ def replot(out: pathlib.Path) -> int:
     return 0
 
 
-def main(argv=None) -> int:
+def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=2, help="cores to use: runs at a time (default 2)")
     ap.add_argument("--out", type=pathlib.Path, default=bench.HERE,
@@ -486,6 +528,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): tiny specimens at the ci preset, 3 variants, 2 cost sizes")
     ap.add_argument("--skip-cost", action="store_true", help="only the speed-against-error part")
+    ap.add_argument("--G", type=float, default=None,
+                    help=f"the interface fracture energy {G_KEY} of every speed-against-error and cost run "
+                         "(default: the solver's default, from `enamel-dem keys`)")
     ap.add_argument("--cases", nargs="+", choices=CASES, help="only these cases (default: all)")
     ap.add_argument("--variants", nargs="+", choices=list(VARIANTS),
                     help=f"only these variants (default: all; `{REFERENCE}` is always run: it is the reference)")
@@ -493,14 +538,20 @@ def main(argv=None) -> int:
                     help="only the kernel profile (bench/profile.md): a few minutes")
     ap.add_argument("--replot", action="store_true",
                     help="run nothing: redraw the figures from OUT/results.csv and OUT/cost_growth.csv")
-    a = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None) -> int:
+    a = parser().parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)   # progress lines reach a log file as they happen
     if a.replot:
         return replot(a.out)
     if not solver().exists():
         print(f"run_bench.py: solver binary {solver()} not found: run `make build`", file=sys.stderr)
         return 2
-    global PRESET
+    global PRESET, BENCH_PHYSICS
+    BENCH_PHYSICS = bench_physics(a.G)
+    g_source = "set by --G" if a.G is not None else "the solver's default, `enamel-dem keys`"
     variants, cases, sizes, extra = VARIANTS, CASES, COST_SIZES, {}
     if a.cases:
         cases = a.cases
@@ -523,8 +574,8 @@ def main(argv=None) -> int:
     print(a.out / "profile.md")
     if a.profile_only:
         return 0
-    if a.runs.exists():
-        shutil.rmtree(a.runs)
+    for sub in (*CASES, "cost"):   # this bench's runs only: runs/bench/ also holds bench-paper's and bench-converged's
+        shutil.rmtree(a.runs / sub, ignore_errors=True)
 
     jobs = speed_error_jobs(cases, variants, PRESET, a.runs, extra)
     run_jobs(jobs, a.jobs)
@@ -551,8 +602,10 @@ def main(argv=None) -> int:
     ref_h5 = next((j.out / "result.h5" for j in jobs if j.variant == REFERENCE), None)
     solver_hash = results.load_result(ref_h5).meta["git_hash"] if ref_h5 and ref_h5.exists() else "unknown"
     header = dict(date=date, machine=machine(), git=solver_hash, preset=PRESET, jobs=a.jobs,
+                  G=BENCH_PHYSICS[G_KEY], G_source=g_source,
                   total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
-    title = f"enamel-dem bench, preset {PRESET}, {header['date']}, {header['machine'].split(',')[0]}"
+    title = (f"enamel-dem bench, preset {PRESET}, G = {header['G']:g}, {header['date']}, "
+             f"{header['machine'].split(',')[0]}")
     pareto_figure(rows, a.out / "out", title)
     if crows:
         cost_figure(crows, a.out / "out", title)

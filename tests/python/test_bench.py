@@ -46,6 +46,13 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
         assert (tmp_path / "out" / name).stat().st_size > 1000
     md = (tmp_path / "results.md").read_text()
     assert "Fastest within the bound" in md or "No fast variant within the bound" in md
+    # at the solver's default G (no --G), named in the report's first line, and the G the runs ran at
+    from bench.run_bench import G_KEY, bench_physics
+    from enamel_results import results
+    G = bench_physics(binary=enamel)[G_KEY]
+    assert md.splitlines()[0].endswith(f", G = {G:g})")
+    ref_run = results.load_result(tmp_path / "runs" / ref["case"] / "paper" / "result.h5")
+    assert ref_run.param(G_KEY) == G
 
 
 def test_within_the_bound_needs_no_quasi_static_warning():
@@ -148,3 +155,23 @@ def test_bench_step_reads_callgrind_annotate_columns():
     got = {"step": ev(1100), "advance": ev(1000), "interfaces": ev(600), "positions": ev(100)}
     items = per_item(got, {"DOF": 10, "nodes": 2, "interfaces": 3})
     assert items["node rows and positions per node"]["Ir"] == 200 and items["interfaces per interface"]["Ir"] == 200
+
+
+def test_bench_G_is_the_solver_default_unless_given(enamel):
+    """`make bench` measures at the solver's default G (read from `enamel-dem keys`, not written in the bench) unless
+    --G names one, and its report's first line and header name the G it ran at."""
+    from bench import run_bench
+    table = "| key | kind | default |\n|---|---|---|\n| `Gamma_k_over_sigma0sq` | physics | 7.5 | [1, 1e4] |\n" \
+            "| `integrator` | numerics | \"paper\" | ... |\n"
+    assert run_bench.key_defaults(table) == {"Gamma_k_over_sigma0sq": "7.5", "integrator": '"paper"'}
+    keys = subprocess.run([str(enamel), "keys"], capture_output=True, text=True, check=True).stdout
+    row = next(line for line in keys.splitlines() if line.startswith("| `Gamma_k_over_sigma0sq`"))
+    listed = float(row.split("|")[3])
+    assert run_bench.bench_physics(binary=enamel) == {"Gamma_k_over_sigma0sq": listed}
+    assert run_bench.bench_physics(3.0, binary=enamel) == {"Gamma_k_over_sigma0sq": 3.0}
+    header = dict(date="2026-12-06 09:00", machine="AMD EPYC", git="abc", preset="reduced", jobs=2, total_min=98.0,
+                  G=listed, G_source="the solver's default, `enamel-dem keys`")
+    md = run_bench.summary_markdown([], [], header)
+    assert md.splitlines()[0] == f"# Bench results (2026-12-06 09:00, G = {listed:g})"
+    assert f"G = Gamma_k_over_sigma0sq = {listed:g} (the solver's default" in md
+    assert run_bench.parser().parse_args(["--G", "3"]).G == 3.0 and run_bench.parser().parse_args([]).G is None

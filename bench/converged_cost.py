@@ -1,0 +1,352 @@
+#!/usr/bin/env python3
+"""`make bench-converged`: what a converged run costs, an older solver's build against this one.
+
+Three cases (CASES: theta_D = 30 and 15 at sigma_ru/sigma0 = 21.4, Er/kd = 10, and theta_D = 30 at 28.5 with
+strengths scattered by cv = 0.3, seed 1) run at the `converged` preset (80 x 80 d, to Delta_a = 30 d) twice:
+by the baseline, the build of commit c09beab (--baseline; built once, from a detached git worktree, into
+build/baseline-<commit>/, and reused), and by the new solver (build/enamel-dem, or ENAMEL_BINARY) with the
+--set overrides that make "the new default". One thread a run, --jobs runs at once, the baseline's runs first.
+
+Per run: core-seconds (the solver process's own CPU time, user + system, from os.wait4, summed over the pieces
+of a resumed run), wall seconds, steps and DOF (the result file's /meta), the machine (CPU model), the start of
+each piece (UTC) and the solver's commit. Per case: the ratio of core-seconds (baseline / new), its two factors
+(fewer steps; cheaper steps), and "the same R-curve" by enamel_results.metrics.same_rcurve at the rate-and-speed
+tolerance (R averaged over (0,30] d and R_init within 2%, broken rods within 20%; the pointwise L2 reported,
+not deciding), computed as `make bench` computes it (bench.run_bench.speed_comparison). The verdict: the ratio
+at least --goal (3) and the same R-curve; a case that misses says what it reached and by which factor.
+
+Resumable: each run goes to RUNS/<preset>/<role>_<solver commit>[_<sets>]/<case>/ with the solver's checkpoints
+(--checkpoint-every) and its --resume; Ctrl-C or SIGTERM stops every run at a checkpoint, and the same command
+continues. A run whose result.h5 is complete and whose record (cost.json: its command and the CPU time of
+each piece) matches the command is not run again; --fresh deletes the runs first.
+
+Writes bench/converged_cost.md and bench/converged_cost.csv at the `converged` preset; at another preset (a
+quick check: --preset ci) they go to the runs folder instead, so a check never stands for the table.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import pathlib
+import re
+import shutil
+import signal
+import subprocess
+import sys
+
+import bench
+from bench import run_bench
+from enamel_results import metrics, paths, results
+from pipeline.phases import set_tag
+
+CASES = ("theta30_s21.4_e10_cv0", "theta15_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1")
+BASELINE_COMMIT = "c09beab"
+PRESET = "converged"
+RATIO_GOAL = 3.0
+TOLERANCE = metrics.TOL_RATE_SPEED
+RUNS = bench.RUNS / "converged_cost"
+TABLE = "converged_cost"             # OUT/converged_cost.md and .csv
+RECORD = "cost.json"                 # in each run's folder: its command and pieces
+CHECKPOINT_EVERY_S = 300.0
+# One thread a run, the static start's factorisation included: CHOLMOD's BLAS (OpenBLAS's pthread build) would
+# otherwise start a thread per core. Set for every solver the harness starts, baseline and new alike.
+ONE_THREAD_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+# ------------------------------------------------------------------------------------------------ solvers
+def baseline_build(commit: str, jobs: int, root: pathlib.Path = paths.ROOT) -> pathlib.Path:
+    """The enamel-dem of `commit`, built once into build/baseline-<commit>/build/ from a detached git worktree in
+    build/baseline-<commit>/src/ (Release, ccache when there is one); an existing binary is reused."""
+    base = root / "build" / f"baseline-{commit}"
+    binary = base / "build" / "enamel-dem"
+    if binary.exists():
+        return binary
+    src = base / "src"
+    if not (src / "CMakeLists.txt").exists():
+        subprocess.run(["git", "worktree", "prune"], cwd=root, check=True)
+        subprocess.run(["git", "worktree", "add", "--detach", str(src), commit], cwd=root, check=True)
+    configure = ["cmake", "-S", str(src), "-B", str(base / "build"), "-DCMAKE_BUILD_TYPE=Release"]
+    if shutil.which("ccache"):
+        configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
+    subprocess.run(configure, check=True)
+    subprocess.run(["cmake", "--build", str(base / "build"), "-j", str(jobs), "--target", "enamel-dem"], check=True)
+    return binary
+
+
+def solver_commit(binary: pathlib.Path) -> str:
+    """The commit a solver binary was built from, as `enamel-dem --version` prints it: `0.1.0 (77c6627724a3)`."""
+    out = subprocess.run([str(binary), "--version"], capture_output=True, text=True, check=True).stdout
+    m = re.search(r"\(([^)]+)\)", out)
+    return m.group(1) if m else "unknown"
+
+
+class Variant:
+    """One solver with its --set overrides: role ("baseline" or "new"), binary, sets (["key=value", ...])."""
+
+    def __init__(self, role: str, binary: pathlib.Path, sets: list[str]):
+        self.role, self.binary, self.sets = role, pathlib.Path(binary), list(sets)
+        self.commit = solver_commit(self.binary)
+        tag = re.sub(r"[^\w.-]", "", set_tag(self.sets))
+        self.label = f"{role}_{self.commit}" + (f"_{tag}" if tag else "")
+
+
+def solver_args(v: Variant, case: str, preset: str, out: pathlib.Path, checkpoint_every: float) -> list[str]:
+    """The run's command (one thread; the solver continues from its checkpoint when it is this build's)."""
+    args = [str(v.binary), "run", str(paths.case_file(case)), "--preset", preset, "--out", str(out), "--resume",
+            "--quiet", "--checkpoint-every", f"{checkpoint_every:g}", "--set", "threads=1"]
+    for s in v.sets:
+        args += ["--set", s]
+    return args
+
+
+# ------------------------------------------------------------------------------------------------- records
+def read_record(out: pathlib.Path) -> dict:
+    try:
+        return json.loads((out / RECORD).read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def completed(out: pathlib.Path) -> bool:
+    try:
+        return results.load_result(out / paths.RESULT_NAMES["completed"]).completed
+    except (results.MissingResult, OSError):
+        return False
+
+
+def prepare(out: pathlib.Path, command: list[str]) -> bool:
+    """Whether the run in `out` must (still) run. A complete result with a record of this command is done; a
+    record of another command (or none beside a result) is started over: record and result removed."""
+    rec = read_record(out)
+    if rec.get("command") == command and completed(out) and rec.get("pieces"):
+        return False
+    if rec.get("command") != command:
+        for name in (RECORD, *paths.RESULT_NAMES.values(), "checkpoint.bin"):
+            (out / name).unlink(missing_ok=True)
+    return True
+
+
+def add_piece(job: run_bench.Job, command: list[str]) -> None:
+    """Append one piece (one solver process) to the run's record: when, how long, its CPU time, exit, machine."""
+    rec = read_record(job.out)
+    if rec.get("command") != command:
+        rec = {"command": command, "pieces": []}
+    start = datetime.datetime.now(datetime.timezone.utc) - datetime.timedelta(seconds=job.wall_s)
+    rec["pieces"].append(dict(started_utc=start.strftime("%Y-%m-%d %H:%M"), cpu_s=job.cpu_s, wall_s=job.wall_s,
+                              exit=job.returncode, machine=run_bench.machine()))
+    (job.out / RECORD).write_text(json.dumps(rec, indent=1) + "\n")
+
+
+# ---------------------------------------------------------------------------------------------------- runs
+def run_all(variants: list[Variant], cases, preset: str, runs: pathlib.Path, jobs: int, nice: int,
+            checkpoint_every: float) -> None:
+    """Every case by every variant, `jobs` at once, the baseline's first; Ctrl-C / SIGTERM: every running solver
+    writes its checkpoint and stops, its piece is recorded, and nothing more starts."""
+    todo, commands = [], {}
+    for v in variants:
+        for case in cases:
+            out = runs / preset / v.label / case
+            cmd = solver_args(v, case, preset, out, checkpoint_every)
+            out.mkdir(parents=True, exist_ok=True)
+            if not prepare(out, cmd):
+                print(f"{v.label} / {case}: complete, not run again ({out})")
+                continue
+            wrapped = (["nice", "-n", str(nice)] if nice else []) + cmd   # nice execs: wait4 sees the solver
+            commands[str(out)] = cmd
+            todo.append(run_bench.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
+                                      expected_s=2.0 if v.role == "baseline" else 1.0))
+    stopping = []
+
+    def forward(signum, frame):
+        stopping.append(signum)
+        for j in todo:
+            if j.pid:
+                os.kill(j.pid, signum)
+    previous = {s: signal.signal(s, forward) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        run_bench.run_jobs(todo, jobs, on_done=lambda j: add_piece(j, commands[str(j.out)]),
+                           stop=lambda: bool(stopping), log_mode="a")
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+    if stopping:
+        raise KeyboardInterrupt("stopped at a checkpoint: the same command continues")
+
+
+# ---------------------------------------------------------------------------------------------------- rows
+def run_row(out: pathlib.Path) -> dict:
+    """One run's numbers: core-seconds and wall seconds summed over its pieces, steps, DOF, commit, machines."""
+    rec = read_record(out)
+    pieces = rec.get("pieces", [])
+    r = results.load_result(out / paths.RESULT_NAMES["completed"])
+    return dict(core_s=sum(p["cpu_s"] for p in pieces), wall_s=sum(p["wall_s"] for p in pieces),
+                pieces=len(pieces), steps=int(r.meta["steps"]), dof=int(r.meta["dof"]), threads=int(r.meta["threads"]),
+                git=str(r.meta["git_hash"]), G=r.param(run_bench.G_KEY),
+                machines=sorted({p["machine"] for p in pieces}),
+                started_utc=pieces[0]["started_utc"] if pieces else "", result=r)
+
+
+def verdict(ratio: float, same: bool | None, goal: float = RATIO_GOAL, why: str = "") -> tuple[bool, str]:
+    """(met, words): met when the ratio of core-seconds is at least `goal` and the R-curve is the same; `why`
+    says how the R-curves differ."""
+    if same is None or ratio is None or not math.isfinite(ratio):
+        return False, "no comparison (a run is missing or incomplete)"
+    misses = (([] if ratio >= goal else [f"ratio {ratio:.2f} < {goal:g}"])
+              + ([] if same else ["not the same R-curve" + (f" ({why})" if why else "")]))
+    return (not misses), ("met" if not misses else "not met: " + ", ".join(misses))
+
+
+def differences(c: metrics.Comparison) -> str:
+    """Which of same_rcurve's conditions a comparison fails, in words."""
+    if not c.comparable:
+        return f"common range (0, {c.hi:.1f}] d shorter than {metrics.MIN_RANGE_OVER_D:g} d: not comparable"
+    out = [f"{name} {rel:+.1%}" for name, rel in (("R mean", c.mean_rel), ("R_init", c.init_rel))
+           if abs(rel) > c.tol]
+    return ", ".join(out + ([] if c.rods_ok else [f"rods {c.rods_a} / {c.rods_b}"]))
+
+
+def case_row(case: str, base: pathlib.Path, new: pathlib.Path, goal: float = RATIO_GOAL) -> dict:
+    """One case's row: both runs' numbers, the ratio and its factors, the comparison and the verdict."""
+    row = dict(case=case)
+    if not (completed(base) and completed(new) and read_record(base).get("pieces") and read_record(new).get("pieces")):
+        row.update(status="incomplete", verdict=verdict(math.nan, None, goal)[1], met=False)
+        return row
+    b, n = run_row(base), run_row(new)
+    same = run_bench.speed_comparison(b["result"], n["result"])
+    for prefix, x in (("baseline", b), ("new", n)):
+        row.update({f"{prefix}_{k}": (";".join(v) if k == "machines" else v) for k, v in x.items() if k != "result"})
+    ratio = b["core_s"] / n["core_s"]
+    row.update(status="complete", ratio=ratio, fewer_steps=b["steps"] / n["steps"],
+               cheaper_step=(b["core_s"] / b["steps"] / b["dof"]) / (n["core_s"] / n["steps"] / n["dof"]))
+    if same is not None:
+        row.update(range_hi=same.hi, R_mean_baseline=same.mean_a, R_mean_new=same.mean_b, R_mean_rel=same.mean_rel,
+                   R_init_rel=same.init_rel, rods_baseline=same.rods_a, rods_new=same.rods_b, rcurve_l2=same.l2,
+                   same_rcurve=same.same)
+    met, words = verdict(ratio, same.same if same else None, goal, differences(same) if same else "")
+    return dict(row, met=met, verdict=words)
+
+
+# -------------------------------------------------------------------------------------------------- output
+def fmt(v, spec=".3g") -> str:
+    return "n/a" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, spec)
+
+
+def markdown(rows: list[dict], header: dict) -> str:
+    """The table: a header (date, machine, preset, G, threads, solvers, sets, bound) and one row per case."""
+    check = "" if header["preset"] == PRESET else f" -- a `{header['preset']}`-preset check, not the converged table"
+    L = [f"# A converged run's cost: {header['baseline']} against {header['new']}{check}", "",
+         f"{header['date']} UTC; {header['machine']}; preset `{header['preset']}`{header['both_sets']}; G = "
+         f"{header['G']}; 1 thread a run (threads=1, {' '.join(f'{k}=1' for k in ONE_THREAD_ENV)}), "
+         f"{header['jobs']} runs at once{header['nice']}; `make bench-converged` "
+         f"(bench/converged_cost.py). Baseline: the build of {header['baseline']} (solver {header['baseline_git']}). "
+         f"New: solver {header['new_git']}{header['new_sets']}. Core-seconds: the solver process's CPU time "
+         f"(user + system) summed over its pieces; ratio = baseline / new = fewer steps x cheaper step (core-s per "
+         f"step and DOF). Same R-curve: `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged over "
+         f"(0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
+         f"pointwise L2 reported, not deciding. Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
+         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | steps (baseline / new) "
+         "| DOF | R mean over (0, hi] d: baseline / new (diff) | R_init diff | broken rods | L2 | same R-curve "
+         "| verdict |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r.get("status") != "complete":
+            L.append(f"| {r['case']} | | | | | | | | | | | | | {r['verdict']} |")
+            continue
+        dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
+        L.append(f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
+                 f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['baseline_steps']} / {r['new_steps']} | "
+                 f"{dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_baseline'), '.4g')} / "
+                 f"{fmt(r.get('R_mean_new'), '.4g')} ({fmt(r.get('R_mean_rel', math.nan) * 100, '+.2f')}%) | "
+                 f"{fmt(r.get('R_init_rel', math.nan) * 100, '+.2f')}% | {r.get('rods_baseline')} / "
+                 f"{r.get('rods_new')} | {fmt(r.get('rcurve_l2', math.nan) * 100, '.2f')}% | "
+                 f"{r.get('same_rcurve')} | {r['verdict']} |")
+    L += ["", "Per run (pieces: solver processes of a resumed run; started: the first piece, UTC):", ""]
+    for r in rows:
+        for role in ("baseline", "new") if r.get("status") == "complete" else ():
+            L.append(f"- {r['case']}, {role}: solver {r[f'{role}_git']}, {r[f'{role}_pieces']} piece(s) from "
+                     f"{r[f'{role}_started_utc']}, {r[f'{role}_core_s']:.1f} core-s, {r[f'{role}_wall_s']:.1f} s "
+                     f"wall, {r[f'{role}_threads']} thread, G = {r[f'{role}_G']:g}, {r[f'{role}_machines']}")
+    return "\n".join(L) + "\n"
+
+
+def write_table(rows: list[dict], header: dict, out: pathlib.Path) -> list[pathlib.Path]:
+    out.mkdir(parents=True, exist_ok=True)
+    md, csv_path = out / f"{TABLE}.md", out / f"{TABLE}.csv"
+    md.write_text(markdown(rows, header))
+    run_bench.write_csv(rows, csv_path)
+    return [md, csv_path]
+
+
+def header_of(rows: list[dict], a, base: Variant, new: Variant) -> dict:
+    gs = sorted({r[k] for r in rows for k in ("baseline_G", "new_G") if k in r})
+    return dict(date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+                machine=run_bench.machine(), preset=a.preset, G=", ".join(f"{g:g}" for g in gs) or "n/a",
+                jobs=a.jobs, nice=f", nice {a.nice}" if a.nice else "", goal=a.goal,
+                baseline=a.baseline if not a.baseline_binary else f"{a.baseline_binary}",
+                new=f"{new.binary}" + (f" with {' '.join(a.set)}" if a.set else ""),
+                baseline_git=base.commit, new_git=new.commit,
+                new_sets=f", --set {' '.join(a.set)}" if a.set else " (no --set: its defaults)",
+                both_sets=f", both with --set {' '.join(a.set_both)}" if a.set_both else "")
+
+
+# ---------------------------------------------------------------------------------------------------- main
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--preset", default=PRESET, help=f"size preset (default {PRESET}; `ci` for a quick check)")
+    ap.add_argument("--cases", nargs="+", default=list(CASES), help=f"cases of paper_cases/ (default: {' '.join(CASES)})")
+    ap.add_argument("--baseline", default=BASELINE_COMMIT, help=f"the baseline's commit (default {BASELINE_COMMIT})")
+    ap.add_argument("--baseline-binary", type=pathlib.Path,
+                    help="an enamel-dem binary to use as the baseline instead of building --baseline")
+    ap.add_argument("--binary", type=pathlib.Path, default=run_bench.solver(),
+                    help="the new solver (default: ENAMEL_BINARY or build/enamel-dem)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override of the new variant only (repeatable): what makes the new default")
+    ap.add_argument("--set-both", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override of both variants (repeatable; e.g. a smaller specimen for a check)")
+    ap.add_argument("--jobs", type=int, default=2, help="runs at once, one thread each (default 2)")
+    ap.add_argument("--nice", type=int, default=0, help="run the solvers at this niceness (default 0: not niced)")
+    ap.add_argument("--goal", type=float, default=RATIO_GOAL, help=f"the ratio to reach (default {RATIO_GOAL:g})")
+    ap.add_argument("--checkpoint-every", type=float, default=CHECKPOINT_EVERY_S,
+                    help=f"a checkpoint every this many wall seconds (default {CHECKPOINT_EVERY_S:g})")
+    ap.add_argument("--runs", type=pathlib.Path, default=RUNS, help=f"where the runs go (default {RUNS})")
+    ap.add_argument("--out", type=pathlib.Path, default=None,
+                    help=f"where {TABLE}.md and .csv go (default: {bench.HERE} at the `{PRESET}` preset, else the "
+                         "runs folder of the preset)")
+    ap.add_argument("--fresh", action="store_true", help="delete this command's runs first and run them all again")
+    ap.add_argument("--report-only", action="store_true", help="run nothing: the table from the runs there are")
+    return ap
+
+
+def main(argv=None) -> int:
+    a = parser().parse_args(argv)
+    sys.stdout.reconfigure(line_buffering=True)
+    bad = [c for c in a.cases if not paths.case_file(c).exists()]
+    if bad or not a.binary.exists():
+        print(f"converged_cost.py: no case file for {bad}" if bad else
+              f"converged_cost.py: solver binary {a.binary} not found: run `make build`", file=sys.stderr)
+        return 2
+    base_binary = a.baseline_binary or baseline_build(a.baseline, a.jobs)
+    base = Variant("baseline", base_binary, a.set_both)
+    new = Variant("new", a.binary, a.set_both + a.set)
+    if a.fresh:
+        for v in (base, new):
+            shutil.rmtree(a.runs / a.preset / v.label, ignore_errors=True)
+    if not a.report_only:
+        os.environ.update(ONE_THREAD_ENV)   # the solvers inherit it
+        try:
+            run_all([base, new], a.cases, a.preset, a.runs, a.jobs, a.nice, a.checkpoint_every)
+        except KeyboardInterrupt as e:
+            print(f"converged_cost.py: {e or 'stopped'}", file=sys.stderr)
+            return 130
+    rows = [case_row(c, a.runs / a.preset / base.label / c, a.runs / a.preset / new.label / c, a.goal)
+            for c in a.cases]
+    out = a.out or (bench.HERE if a.preset == PRESET else a.runs / a.preset)
+    print(write_table(rows, header_of(rows, a, base, new), out)[0])   # write_csv names the .csv
+    return 0 if all(r["status"] == "complete" for r in rows) else 1   # the verdicts are in the table
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,125 @@
+"""`make bench-converged`'s script (bench/converged_cost.py): end to end on one small case at the ci preset with the
+current binary as both baseline and new (stopped by SIGINT at a checkpoint, then continued), and its verdict and
+table from crafted numbers. Correctness only: no speed is asserted (the ratio of one binary against itself is
+whatever the machine gives)."""
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import ROOT
+from bench import converged_cost
+
+CASE = "theta30_s21.4_e10_cv0"
+# 28 x 4 d to Delta_a = 11 d: a common range over 10 d, so that same_rcurve can compare (~9 core-s a run)
+SMALL = ["w_s_over_d=28", "h_s_over_d=4", "stop_da_over_d=11"]
+
+
+def harness(enamel, tmp_path, *extra):
+    args = [sys.executable, "-m", "bench.converged_cost", "--preset", "ci", "--cases", CASE, "--baseline-binary",
+            str(enamel), "--binary", str(enamel), "--runs", str(tmp_path / "runs"), "--out", str(tmp_path)]
+    for s in SMALL:
+        args += ["--set-both", s]
+    return [*args, *extra]
+
+
+def run_dirs(tmp_path):
+    return sorted((tmp_path / "runs" / "ci").glob(f"*/{CASE}"))
+
+
+def pieces(d):
+    return json.loads((d / "cost.json").read_text())["pieces"]
+
+
+def test_stopped_continued_and_tabled(enamel, tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    first = subprocess.Popen(harness(enamel, tmp_path), cwd=ROOT, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    t0 = time.monotonic()
+    while len([d for d in run_dirs(tmp_path) if (d / ".lock").exists()]) < 2 and time.monotonic() - t0 < 30:
+        time.sleep(0.2)
+    time.sleep(2.0)
+    first.send_signal(signal.SIGINT)           # forwarded: each solver writes its checkpoint and stops
+    out, err = first.communicate(timeout=120)
+    assert first.returncode == 130, (out, err)
+    dirs = run_dirs(tmp_path)
+    assert [d.parent.name.split("_")[0] for d in dirs] == ["baseline", "new"]
+    for d in dirs:
+        assert not (d / "result.h5").exists() and (d / "checkpoint.bin").exists()
+        assert len(pieces(d)) == 1 and pieces(d)[0]["exit"] != 0 and pieces(d)[0]["cpu_s"] > 0
+    assert not (tmp_path / "converged_cost.md").exists()
+
+    second = subprocess.run(harness(enamel, tmp_path), cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert second.returncode == 0, second.stderr
+    core = {d.parent.name.split("_")[0]: sum(p["cpu_s"] for p in pieces(d)) for d in dirs}
+    assert all(len(pieces(d)) == 2 and pieces(d)[1]["exit"] == 0 for d in dirs)
+    rows = list(csv.DictReader(open(tmp_path / "converged_cost.csv")))
+    assert len(rows) == 1
+    row = rows[0]
+    assert row["case"] == CASE and row["status"] == "complete"
+    assert math.isclose(float(row["ratio"]), core["baseline"] / core["new"], rel_tol=1e-5)
+    assert math.isclose(float(row["baseline_core_s"]), core["baseline"], rel_tol=1e-5)
+    # the same binary, continued from checkpoints at different steps: the same run, bit for bit
+    assert row["baseline_steps"] == row["new_steps"] and int(row["new_dof"]) > 0
+    assert row["same_rcurve"] == "True" and float(row["R_mean_rel"]) == 0.0 and float(row["R_init_rel"]) == 0.0
+    assert float(row["range_hi"]) >= 10 and row["baseline_pieces"] == "2" and row["new_threads"] == "1"
+    assert float(row["fewer_steps"]) == 1.0
+    assert math.isclose(float(row["fewer_steps"]) * float(row["cheaper_step"]), float(row["ratio"]), rel_tol=1e-4)
+    md = (tmp_path / "converged_cost.md").read_text()
+    assert "a `ci`-preset check, not the converged table" in md and "1 thread a run" in md
+    assert f"G = {float(row['new_G']):g}" in md and f"| {CASE} |" in md
+    assert row["verdict"] in ("met", f"not met: ratio {float(row['ratio']):.2f} < 3")
+
+    again = subprocess.run(harness(enamel, tmp_path), cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0 and "complete, not run again" in again.stdout
+    assert all(len(pieces(d)) == 2 for d in dirs)   # a finished run is not run again
+
+
+@pytest.mark.parametrize("ratio, same, met", [(3.0, True, True), (7.5, True, True), (2.9, True, False),
+                                              (5.0, False, False), (2.0, False, False), (math.nan, None, False)])
+def test_verdict(ratio, same, met):
+    ok, words = converged_cost.verdict(ratio, same)
+    assert ok is met
+    assert (words == "met") is met
+    if not met and same is not None:
+        assert (f"ratio {ratio:.2f} < 3" in words) is (ratio < 3)
+        assert ("not the same R-curve" in words) is (not same)
+
+
+def crafted_row(case, b_core, n_core, same):
+    ratio = b_core / n_core
+    met, words = converged_cost.verdict(ratio, same, why="" if same else "R mean -2.5%")
+    row = dict(case=case, status="complete", ratio=ratio, fewer_steps=2.0, cheaper_step=ratio / 2.0, met=met,
+               verdict=words, range_hi=30.2, R_mean_baseline=6.5, R_mean_new=6.5 * (1 if same else 0.975),
+               R_mean_rel=0.0 if same else -0.025, R_init_rel=0.001, rods_baseline=31, rods_new=30, rcurve_l2=0.01,
+               same_rcurve=same)
+    for role, core, steps in (("baseline", b_core, 544364), ("new", n_core, 272182)):
+        row.update({f"{role}_core_s": core, f"{role}_wall_s": core * 1.01, f"{role}_steps": steps,
+                    f"{role}_dof": 222816, f"{role}_pieces": 1, f"{role}_threads": 1, f"{role}_G": 10.0,
+                    f"{role}_git": "abc", f"{role}_machines": "AMD EPYC", f"{role}_started_utc": "2026-12-06 07:00"})
+    return row
+
+
+def test_table_from_crafted_numbers(tmp_path):
+    rows = [crafted_row("a", 1376.0, 1376.0 / 2.9, True), crafted_row("b", 1376.0, 400.0, False),
+            crafted_row("c", 1376.0, 1376.0 / 3.2, True), dict(case="d", status="incomplete", met=False,
+                                                             verdict=converged_cost.verdict(math.nan, None)[1])]
+    header = dict(date="2026-12-06 08:00", machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
+                  goal=3.0, baseline="c09beab", new="build/enamel-dem", baseline_git="c09beab539e9",
+                  new_git="abc", new_sets=" (no --set: its defaults)", both_sets="")
+    md_path, csv_path = converged_cost.write_table(rows, header, tmp_path)
+    md = md_path.read_text()
+    lines = {line.split("|")[1].strip(): line for line in md.splitlines() if line.startswith("| ") and "---" not in line}
+    assert "| **2.90** |" in lines["a"] and "not met: ratio 2.90 < 3" in lines["a"]
+    assert "| **3.44** |" in lines["b"] and "not met: not the same R-curve (R mean -2.5%)" in lines["b"]
+    assert "| **3.20** |" in lines["c"] and lines["c"].rstrip().endswith("| True | met |")
+    assert "no comparison" in lines["d"]
+    assert "not the converged table" not in md and "G = 10" in md and "c09beab" in md
+    got = list(csv.DictReader(open(csv_path)))
+    assert [r["met"] for r in got] == ["False", "False", "True", "False"]
