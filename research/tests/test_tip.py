@@ -28,3 +28,41 @@ def test_cut_reading_advances_before_its_first_break_and_records(run, tmp_path, 
     saved = json.loads((tmp_path / "data" / "ci_cut.json").read_text())
     assert saved["events"] == ev and saved["keys"]["reading"] == "cut"
     assert "| ci_cut | 16 | 10 | cut |" in tip.report()
+
+
+def crafted(size, G, reading, phase, R_init, level, kinks_first):
+    """A record as tip.record writes it, with a flat R-curve at `level` after its first point at 0.5 d."""
+    da = [0.5] + [1.0 + 0.5 * i for i in range(60)]
+    return dict(keys=dict(size=size, G=G, reading=reading, phase=phase), da=da, R=[R_init] + [level] * 60,
+                broken_rods=10, R_init=R_init, statements=dict(i_kinks_first=kinks_first))
+
+
+def test_candidates_apply_the_rule_to_the_size_pairs():
+    recs = [crafted(s, 10, "cut", 0, 3.0, 6.0, True) for s in (80, 100)]
+    recs += [crafted(s, 10, "intact", 0, 5.0, 6.0, False) for s in (80, 100)]
+    recs += [crafted(s, 12, "cut", 0, 3.0, 6.9 if s == 80 else 8.0, True) for s in (80, 100)]  # +15.9 %: not converged
+    cands = {(c["G"], c["reading"]): c for c in tip.candidates(recs)}
+    assert set(cands) == {(10, "cut"), (10, "intact"), (12, "cut")}   # no average without all four phases
+    assert cands[10, "cut"]["converged"] and cands[10, "cut"]["i"] and cands[10, "cut"]["ii"]
+    assert not cands[10, "intact"]["i"] and not cands[10, "intact"]["ii"]       # 5.0 > 0.8 x 6.0
+    assert not cands[12, "cut"]["converged"]
+    best, how = tip.select(list(cands.values()))
+    assert (best["G"], best["reading"]) == (10, "cut") and how.startswith("(i)")
+
+
+def test_select_keeps_intact_unless_another_reading_is_nearer_7_by_more_than_5_percent():
+    def cand(reading, level):
+        return dict(G=10, reading=reading, converged=True, i=False, ii=False, level=level)
+    best, how = tip.select([cand("intact", 6.0), cand("cut", 6.3)])           # nearer by 0.3 <= 0.35
+    assert best["reading"] == "intact" and "(iii)" in how
+    best, _ = tip.select([cand("intact", 6.0), cand("cut", 6.5)])             # nearer by 0.5 > 0.35
+    assert best["reading"] == "cut"
+
+
+def test_the_averaged_reading_needs_kinks_first_in_three_of_four_phases():
+    recs = []
+    for s in (80, 100):
+        for ph, ok in zip(tip.PHASES, (False, False, True, True)):
+            recs.append(crafted(s, 10, "intact", ph, 3.0, 6.0, ok))
+    avg = next(c for c in tip.candidates(recs) if c["reading"] == "averaged")
+    assert avg["converged"] and avg["ii"] and not avg["i"]

@@ -3,6 +3,7 @@
     python3 -m research.tip.tip run NAME --size 80 --G 10 --reading intact --phase 0     # run (resumable), record
     python3 -m research.tip.tip record NAME                                            # record a finished run
     python3 -m research.tip.tip report                                                 # the runs table, from data/
+    python3 -m research.tip.tip candidates                                             # the rule applied, from data/
 
 A run goes to runs/tip/NAME (niced, one thread, checkpointed); its record to data/NAME.json: the case, the keys of
 the candidate, the metrics the rule reads (R_init, the (0,30] and (5,25] means, the first rod break and the kinks
@@ -97,6 +98,87 @@ def report() -> str:
     return "\n".join(lines) + "\n"
 
 
+PHASES = (0.0, 0.25, 0.5, 0.75)   # the averaged reading: phase 0 is the intact run
+PAPER_LEVEL = 7.0
+READING_MARGIN = 0.05             # another reading replaces intact by (iii) only when nearer 7 by more than this
+
+
+def curve(rec: dict) -> metrics.RCurve:
+    return metrics.RCurve.of(rec["da"], rec["R"], broken_rods=rec["broken_rods"])
+
+
+def members(recs: list[dict], G: float, size: int, reading: str) -> list[dict] | None:
+    """The records a candidate reads at one size: its run, or for `averaged` the intact run and the phases."""
+    def find(rd, ph):
+        return next((r for r in recs if r["keys"]["size"] == size and r["keys"]["G"] == G
+                     and r["keys"]["reading"] == rd and abs(r["keys"]["phase"] - ph) < 1e-9), None)
+    got = [find(reading, 0.0)] if reading != "averaged" else [find("intact", ph) for ph in PHASES]
+    return None if any(r is None for r in got) else got
+
+
+def judged_at(group: list[dict]) -> dict:
+    """One candidate at one size: its R-curve (the phase average for `averaged`), (i) (at least 3 of 4 phases for
+    the average), (ii) on that curve's first point, and its (5,25] level."""
+    if len(group) == 1:
+        c, holds_i = curve(group[0]), group[0]["statements"]["i_kinks_first"]
+    else:
+        c = metrics.phase_average([curve(r) for r in group]).curve
+        holds_i = sum(r["statements"]["i_kinks_first"] for r in group) >= 3
+    level = metrics.advance_mean(c, 5, 25)
+    return dict(curve=c, i=bool(holds_i), ii=bool(float(c.R[0]) <= 0.8 * level), level=level)
+
+
+def candidates(recs: list[dict]) -> list[dict]:
+    """Every candidate (G, reading) with both sizes recorded: the size pair by the measure (metrics.same_rcurve
+    at TOL_MESH_SIZE), (i) and (ii) at both sizes, and the level (iii): the mean of the pair's (5,25] levels."""
+    out = []
+    for G in sorted({r["keys"]["G"] for r in recs}):
+        for reading in ("intact", "cut", "averaged"):
+            small, large = members(recs, G, 80, reading), members(recs, G, 100, reading)
+            if small is None or large is None:
+                continue
+            a, b = judged_at(small), judged_at(large)
+            cmp = metrics.same_rcurve(a["curve"], b["curve"], metrics.TOL_MESH_SIZE)
+            out.append(dict(G=G, reading=reading, converged=bool(cmp.same), mean_rel=cmp.mean_rel,
+                            init_rel=cmp.init_rel, i=a["i"] and b["i"], ii=a["ii"] and b["ii"],
+                            level=(a["level"] + b["level"]) / 2, levels=(a["level"], b["level"])))
+    return out
+
+
+def select(cands: list[dict]) -> tuple[dict | None, str]:
+    """The rule (README, "Selection rule"): among the converged candidates meeting (i) and (ii), the level nearest
+    7; if none meets both, by (iii) among the converged ones, intact kept unless another is nearer 7 by > 5 %."""
+    conv = [c for c in cands if c["converged"]]
+    meeting = [c for c in conv if c["i"] and c["ii"]]
+    if meeting:
+        return min(meeting, key=lambda c: abs(c["level"] - PAPER_LEVEL)), "(i), (ii), then (iii)"
+    if not conv:
+        return None, "no candidate is converged"
+    best = min(conv, key=lambda c: abs(c["level"] - PAPER_LEVEL))
+    intact = [c for c in conv if c["reading"] == "intact"]
+    if intact and best["reading"] != "intact":
+        keep = min(intact, key=lambda c: abs(c["level"] - PAPER_LEVEL))
+        if abs(keep["level"] - PAPER_LEVEL) - abs(best["level"] - PAPER_LEVEL) <= READING_MARGIN * PAPER_LEVEL:
+            best = keep
+    return best, "none meets (i) and (ii): (iii) alone"
+
+
+def candidates_report() -> str:
+    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    cands = candidates(recs)
+    lines = ["| G | reading | 80 vs 100 d: mean (0,30] | R_init | converged | (i) both | (ii) both | level (5,25] 80 / 100 "
+             "| level of the pair |", "|" + "---|" * 9]
+    for c in cands:
+        lines.append(f"| {c['G']:g} | {c['reading']} | {c['mean_rel']:+.1%} | {c['init_rel']:+.1%} | "
+                     f"{'yes' if c['converged'] else 'no'} | {'holds' if c['i'] else 'fails'} | "
+                     f"{'holds' if c['ii'] else 'fails'} | {c['levels'][0]:.2f} / {c['levels'][1]:.2f} | "
+                     f"{c['level']:.2f} |")
+    best, how = select(cands)
+    chosen = "none" if best is None else f"G = {best['G']:g}, {best['reading']}"
+    lines += ["", f"Selected so far: {chosen} ({how})."]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m research.tip.tip", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -110,9 +192,10 @@ def main(argv=None) -> int:
     rec = sub.add_parser("record", help="record a finished run of runs/tip/NAME")
     rec.add_argument("name")
     sub.add_parser("report", help="the runs table from data/")
+    sub.add_parser("candidates", help="the candidates with both sizes recorded, judged by the rule, from data/")
     a = ap.parse_args(argv)
-    if a.cmd == "report":
-        print(report(), end="")
+    if a.cmd in ("report", "candidates"):
+        print(report() if a.cmd == "report" else candidates_report(), end="")
         return 0
     out = RUNS / a.name
     if a.cmd == "record":
