@@ -22,7 +22,7 @@
 #   make bench          speed against error of every integrator and knob, and cost growth, in one run (~100 min on
 #                       2 cores; its cases at G = 3, set in bench/run_bench.py): bench/results.csv,
 #                       bench/cost_growth.csv, bench/results.md, bench/out/*.png
-#   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
+#   make bench-step     instructions and cache misses per phase of the step, per DOF and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate
 #                       from the static start (1.3 h on 2 cores of an AMD EPYC, 2026-12-04; Ctrl-C writes a
@@ -118,7 +118,7 @@ clean:
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS)
 
-# Instructions and cache misses per kernel, per interface and per node (valgrind callgrind; independent of how
+# Instructions and cache misses per phase of the step, per DOF and per node (valgrind callgrind; independent of how
 # busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.
 bench-step: $(ENAMEL)
 	$(PYTHON) -m bench.step_instructions --binary $(ENAMEL) $(if $(BENCH_STEP_AGAINST),--against $(BENCH_STEP_AGAINST))
