@@ -20,7 +20,7 @@ enum class StepPhase : int {
   SliceWrites,
   SliceBarrier,
   GripsAndWork,
-  PositionsOfGrips,
+  ClockAndGrips,
   // paper (integrators/newmark.cpp)
   PaperPositions,
   PaperBoundaryConditions,
@@ -64,7 +64,7 @@ inline constexpr std::array<StepPhaseInfo, kStepPhaseCount> kStepPhases = {{
     {StepPhase::SliceBarrier, "barrier", 2, "mean over the threads: waiting for the other threads at the pass's barrier"},
     {StepPhase::GripsAndWork, "grips and work", 1,
      "computeReactions, addWorkOfGrips, addDampingWork: the grips' reactions and work, the damping work"},
-    {StepPhase::PositionsOfGrips, "clock and grips", 1,
+    {StepPhase::ClockAndGrips, "clock and grips", 1,
      "moveOfStep, advanceClock, prescribeDisplacements, boundOfMove: t_{n+1}, q of the grips, the step's move"},
     {StepPhase::PaperPositions, "positions", 1, "predictVelocities, advancePositions: w, q_{n+1}"},
     {StepPhase::PaperBoundaryConditions, "boundary conditions", 1,

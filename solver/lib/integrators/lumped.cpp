@@ -193,7 +193,7 @@ class LumpedIntegrator : public Integrator {
     prescribeDisplacements(ops, mat.loading, s);
     moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
     largestValue_ = std::max(move.largestValue, largestShape_ * std::abs(s.appliedDisplacement));  // >= max |q_{n+1}|
-    laps.lap(StepPhase::PositionsOfGrips);
+    laps.lap(StepPhase::ClockAndGrips);
   }
 
   double lastStepMoveBound() const override { return moveBound_; }
