@@ -20,13 +20,13 @@
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
 #   make bench          speed against error of every integrator and knob, and cost growth, in one run (~100 min on
-#                       2 cores at G = 3; at the solver's default G, which the report's header names, or
+#                       2 cores at G = 3, ~2.5 h at G = 10; at the solver's default G, which the report's header names, or
 #                       BENCH_G=3): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
 #                       cases at the `converged` preset to Delta_a = 30 d, each by c09beab's build (built once in
 #                       build/baseline-c09beab/) and by build/enamel-dem with CONVERGED_SET, one thread a run, JOBS
 #                       at once, resumable (6 runs of 23-37 min at c09beab's speed): bench/converged_cost.md, .csv
-#   make bench-step     instructions and cache misses per kernel, per interface and per node (valgrind; ~3 min):
+#   make bench-step     instructions and cache misses per phase of the step, per DOF and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate
 #                       from the static start (1.3 h on 2 cores of an AMD EPYC, 2026-12-04; Ctrl-C writes a
@@ -129,7 +129,7 @@ bench-converged: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.converged_cost --jobs $(JOBS) \
 	  $(foreach s,$(CONVERGED_SET),--set '$(s)') $(CONVERGED_ARGS)
 
-# Instructions and cache misses per kernel, per interface and per node (valgrind callgrind; independent of how
+# Instructions and cache misses per phase of the step, per DOF and per node (valgrind callgrind; independent of how
 # busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.
 bench-step: $(ENAMEL)
 	$(PYTHON) -m bench.step_instructions --binary $(ENAMEL) $(if $(BENCH_STEP_AGAINST),--against $(BENCH_STEP_AGAINST))

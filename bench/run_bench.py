@@ -12,9 +12,10 @@ machine in the same state:
    error against the reference of the same case: R-curve relative L2 difference over the common Delta_a
    range, R_init and R_ss differences, broken rod elements. The runs share the cores two at a time
    (--jobs), the long reference runs first.
-2. Kernel profile: `enamel-dem profile` on the `paper` preset's theta_D = 30 case (1.39 M DOF) with the
-   fastest lumped knobs, on 1 and on 2 threads: each kernel's time per step, the bytes it must move per step
-   and the bandwidth it achieves next to a triad measured in the same process (bench/profile.md).
+2. Step profile: `enamel-dem profile` on the `paper` preset's theta_D = 30 case (1.39 M DOF) with the
+   fastest lumped knobs, on 1 and on 2 threads: each phase of the real step timed by the step's own timers,
+   its time per step and, where counted, the bytes it must move per step and the bandwidth it achieves next to
+   a triad measured in the same process (bench/profile.md).
 3. Cost growth. Short runs (a fixed number of steps) of the theta_D = 30 case at growing specimen size and
    finer slice spacing h_e, both integrators: wall time per step against DOF and h_e, and from it an estimate
    of the wall time of one whole run, up to the `paper` preset (200 d x 200 d).
@@ -57,7 +58,7 @@ REFERENCE = "paper"
 # G = Gamma_i k / sigma0^2 (case key G_KEY), the solver's default unless --G names another, set explicitly on every
 # run and named in the report's header (bench_physics). The bench measured at G = 3 from 2026-11-23 to 2026-12-05,
 # the default before 6008856 (bench/README.md keeps those rows as history); at G = 10 its `paper` references take
-# ~2 h each. The kernel profile steps at the default, as `make bench-paper` and bench.profile_pair do.
+# ~2 h each. The step profile steps at the default, as `make bench-paper` and bench.profile_pair do.
 G_KEY = "Gamma_k_over_sigma0sq"
 BENCH_PHYSICS = {}   # set by main(): {G_KEY: G}
 
@@ -127,7 +128,7 @@ COST_PAPER_MAX_DOF = 150_000   # the paper scheme's factorisation beyond this is
 COST_WORK = {"lumped": 3e8, "paper": 6e7}   # DOF x steps per cost run
 
 
-# Kernel profile: the paper preset's case with the fastest lumped knobs (what `make bench-paper` steps).
+# Step profile: the paper preset's case with the fastest lumped knobs (what `make bench-paper` steps).
 PROFILE_CASE = CASES[0]
 PROFILE_SETS = {"integrator": '"lumped"', "dt_factor": 0.22, "damping_cap": 0.5}
 
@@ -535,7 +536,7 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--variants", nargs="+", choices=list(VARIANTS),
                     help=f"only these variants (default: all; `{REFERENCE}` is always run: it is the reference)")
     ap.add_argument("--profile-only", action="store_true",
-                    help="only the kernel profile (bench/profile.md): a few minutes")
+                    help="only the step profile (bench/profile.md): a few minutes")
     ap.add_argument("--replot", action="store_true",
                     help="run nothing: redraw the figures from OUT/results.csv and OUT/cost_growth.csv")
     return ap
@@ -567,7 +568,7 @@ def main(argv=None) -> int:
     date = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     a.out.mkdir(parents=True, exist_ok=True)
     profile_preset, profile_extra = ("ci", {"w_s_over_d": 8, "h_s_over_d": 4}) if a.quick else ("paper", {})
-    profile_md = (f"# Kernel profile ({date}; {machine()}; `enamel-dem profile`, preset `{profile_preset}`, "
+    profile_md = (f"# Step profile ({date}; {machine()}; `enamel-dem profile`, preset `{profile_preset}`, "
                   f"{PROFILE_CASE}, lumped dt 0.22 cap 0.5)\n\n"
                   + profile_markdown(profile_preset, extra_sets=profile_extra))
     (a.out / "profile.md").write_text(profile_md)
@@ -610,7 +611,7 @@ def main(argv=None) -> int:
     if crows:
         cost_figure(crows, a.out / "out", title)
     md = a.out / "results.md"
-    md.write_text(summary_markdown(rows, crows, header) + "\n" + profile_md.replace("# Kernel profile", "## Kernel profile", 1))
+    md.write_text(summary_markdown(rows, crows, header) + "\n" + profile_md.replace("# Step profile", "## Step profile", 1))
     print(md)
     bad = [r for r in rows if r.get("exit_code") != 0]
     for r in bad:

@@ -1,23 +1,29 @@
-"""`make bench-step`: what one time step costs in instructions and cache misses, per kernel, per interface and per
-node, counted by valgrind's callgrind (with its cache simulation) on a fixed model. Counts do not depend on how
-busy the machine is, so two binaries can be compared on any machine; the wall-clock profile (`enamel-dem
-profile`, interleaved rounds) is printed next to them.
+"""`make bench-step`: what one time step costs in instructions and cache misses, per phase of the step, per node
+and per DOF, counted by valgrind's callgrind (with its cache simulation) on a fixed model. Counts do not depend on
+how busy the machine is, so two binaries can be compared on any machine; the wall-clock profile (`enamel-dem
+profile`: the step's phase timers) is printed next to them.
 
     python3 -m bench.step_instructions [--binary build/enamel-dem] [--against OTHER_BINARY] [--out DIR]
 
 The model: theta30 (21.4, 10) at 40 x 20 d, h_e 0.3 d, the lumped scheme (dt_factor 0.22, damping_cap 0.5), one
-thread; `enamel-dem profile --steps 10` under callgrind, collecting only inside profileKernels (the model's
-set-up is left out). Per call of each kernel (from callgrind's inclusive counts and call counts):
+thread; `enamel-dem profile --steps 10` under callgrind, collecting only inside Simulation::step (the model's set-up
+and the profile's own measurements are left out; its 200 warm-up steps are counted with the 10 timed ones, whose
+timers' laps add about 0.05% to the counts). Each phase is a function of the real step, found by
+its name (PHASES below), and counted inclusively (with what it calls) over all its calls, per step (per call of
+Simulation::step):
 
-- step: Simulation::step; advance: the integrator's advance (the slice pass and the position update);
-- interfaces: the interface pass alone (the profile's "interfaces" kernel, with a copy of the step's schedule:
-  computeInterfaceCorrectionsScheduled, the law where it is due, in solvers that apply the elastic interfaces
-  as K_I q in the node rows; computeForcesForInterfacesScheduled, every interface's force, in solvers before
-  them; computeForcesForInterfaces in solvers before the schedule), per interface;
-- node rows and positions: advance - interfaces, per node (the profile's "nodes"; the step computes q_{n+1} in
-  its node pass, solvers before it in a pass of their own: both counted here, so the row compares; since the
-  elastic interfaces are K_I q, their forces are counted here, not under interfaces: compare the whole step);
-- positions: advancePositions alone, per DOF (the profile's "(positions)").
+- step: enamel::Simulation::step(), per DOF;
+- advance: LumpedIntegrator::advance, the scheme's step, per DOF;
+- slice pass: LumpedIntegrator::computeForcesAndAdvanceVelocities, the pass over the slices (the interface pass
+  where due, the node rows, the slices' writes), per node;
+- node rows: enamel::advanceNodesOfSlice (the copy the loader picked: valgrind has no AVX-512, so the x86-64-v3
+  one), per node: K_I q, K q, K v, v_{n+1/2}, the damping sums, q_{n+1};
+- law: evaluateDueInterface, per call: one due interface seen by the law (shown where the counted steps have one).
+
+What it cannot count by name: the interface pass's scan of its schedule (addInterfaceCorrectionsOfSliceScheduled
+is inlined into the slice pass, and counted in it) and, since the step moves q in its node pass, a position update
+of its own (the counts of solvers that had one, as advancePositions, are in earlier pages). A binary whose step
+lacks one of the required functions (an older solver's) is refused with the names it lacks.
 
 Writes DIR/step_instructions.md (default bench/) and prints it.
 """
@@ -40,16 +46,17 @@ SETS = {"w_s_over_d": "40", "h_s_over_d": "20", "integrator": '"lumped"', "dt_fa
         "damping_cap": "0.5", "threads": "1"}
 STEPS = 10
 EVENTS = ("Ir", "D1mr", "D1mw", "DLmr", "DLmw")   # instructions; first-level and last-level data misses
-# kernel: (the function's names as callgrind_annotate prints them, the first found counts; the count it is
-# divided by). The interfaces kernel is the scheduled pass the step runs (solvers before it: the pass of every
-# interface by the law).
-KERNELS = {
+# phase: (what callgrind_annotate prints of the function's name, every piece of it (the slice pass: the body of its
+# parallel region, which OpenMP makes a function of its own; the pass itself is inlined into advance); what its count
+# per step is divided by: DOF, nodes, or "call" for a count per call of the function).
+PHASES = {
     "step": (("enamel::Simulation::step()",), "DOF"),
     "advance": (("LumpedIntegrator::advance(",), "DOF"),
-    "interfaces": (("enamel::computeInterfaceCorrectionsScheduled(", "enamel::computeForcesForInterfacesScheduled(",
-                    "enamel::computeForcesForInterfaces("), "interfaces"),
-    "positions": (("enamel::advancePositions(",), "DOF"),
+    "slice pass": (("LumpedIntegrator::computeForcesAndAdvanceVelocities(", "[clone ._omp_fn.0]"), "nodes"),
+    "node rows": (("enamel::advanceNodesOfSlice(",), "nodes"),
+    "law": (("evaluateDueInterface(",), "call"),
 }
+OPTIONAL = {"law"}  # no interface due in the counted steps: no call
 
 
 def solver_args(binary) -> list[str]:
@@ -72,7 +79,7 @@ def model_counts(binary) -> dict:
 def callgrind(binary, workdir: pathlib.Path) -> tuple[pathlib.Path, str]:
     out = workdir / "callgrind.out"
     r = subprocess.run(["valgrind", "--tool=callgrind", "--cache-sim=yes", f"--callgrind-out-file={out}",
-                        "--toggle-collect=enamel::profileKernels*"] + solver_args(binary),
+                        "--toggle-collect=enamel::Simulation::step()"] + solver_args(binary),
                        capture_output=True, text=True)
     if r.returncode != 0:
         raise SystemExit(f"bench-step: valgrind failed ({r.returncode}): {r.stderr.strip().splitlines()[-1:]}")
@@ -86,47 +93,52 @@ def _counts(line: str) -> list[int]:
     return [0 if t == "." else int(t.replace(",", "")) for t in tokens][:len(EVENTS)]
 
 
-def inclusive_per_call(out: pathlib.Path) -> dict:
-    """{kernel: {event: inclusive count per call}} from callgrind_annotate's caller tree: the line marked '*' of
-    the function carries its inclusive counts, the lines above it ('<') its callers with their call counts."""
+def inclusive_counts(out: pathlib.Path) -> dict:
+    """{phase: {event: inclusive count over all calls, 'calls': calls}} from callgrind_annotate's caller tree: the
+    line marked '*' of the function carries its inclusive counts, the lines above it ('<') its callers with their
+    call counts."""
     text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=caller", "--threshold=100", f"--show={','.join(EVENTS)}",
                            str(out)], capture_output=True, text=True, check=True).stdout
     blocks = text.split("\n\n")
     got = {}
-    for kernel, (names, _) in KERNELS.items():
-        for name, b in ((n, b) for n in names for b in blocks):
-            if kernel in got:
+    for phase, (names, _) in PHASES.items():
+        for b in blocks:
+            if phase in got:
                 break
             lines = b.strip().splitlines()
-            star = [ln for ln in lines if re.search(r"\*\s+.*" + re.escape(name), ln) and "_omp_fn" not in ln]
+            star = [ln for ln in lines if re.search(r"\*\s+", ln) and all(n in ln for n in names)
+                    and ("_omp_fn" in names[-1] or "_omp_fn" not in ln)]
             if not star:
                 continue
-            counts = _counts(star[0])
-            calls = sum(int(c) for ln in lines if ln.lstrip().startswith(tuple("0123456789")) and " < " in ln
-                        for c in re.findall(r"\((\d+)x\)", ln))
+            calls = sum(int(c.replace(",", "")) for ln in lines if ln.lstrip().startswith(tuple("0123456789"))
+                        and " < " in ln for c in re.findall(r"\(([\d,]+)x\)", ln))
             if calls:
-                got[kernel] = {e: c / calls for e, c in zip(EVENTS, counts)} | {"calls": calls}
+                got[phase] = dict(zip(EVENTS, _counts(star[0]))) | {"calls": calls}
                 break
-    missing = set(KERNELS) - set(got) - {"positions"}  # the position update alone: shown where found
+    missing = set(PHASES) - set(got) - OPTIONAL
     if missing:
-        raise SystemExit(f"bench-step: callgrind_annotate shows no {sorted(missing)} (inlined or renamed?)")
+        raise SystemExit(f"bench-step: callgrind_annotate shows no {sorted(missing)} (inlined, renamed, or a solver "
+                         f"before the step's phase functions?)")
     return got
 
 
 def per_item(got: dict, sizes: dict) -> dict:
-    """Counts per interface, per node and per DOF; the node rows with the position update."""
-    nodes = {e: got["advance"][e] - got["interfaces"][e] for e in EVENTS}
-    return {"step per DOF": {e: got["step"][e] / sizes["DOF"] for e in EVENTS},
-            "interfaces per interface": {e: got["interfaces"][e] / sizes["interfaces"] for e in EVENTS},
-            "node rows and positions per node": {e: nodes[e] / sizes["nodes"] for e in EVENTS},
-            **({"positions per DOF": {e: got["positions"][e] / sizes["DOF"] for e in EVENTS}}
-               if "positions" in got else {})}
+    """Counts per step (per call of Simulation::step), divided by what each phase loops over (PHASES)."""
+    steps = got["step"]["calls"]
+    items = {}
+    for phase, (_, unit) in PHASES.items():
+        if phase not in got:
+            continue
+        label, divisor = (f"{phase} per call", got[phase]["calls"]) if unit == "call" else \
+            (f"{phase} per {'DOF' if unit == 'DOF' else 'node'}", steps * sizes[unit])
+        items[label] = {e: got[phase][e] / divisor for e in EVENTS}
+    return items
 
 
 def measure(binary) -> tuple[dict, dict, str]:
     with tempfile.TemporaryDirectory() as d:
         out, profile = callgrind(binary, pathlib.Path(d))
-        got = inclusive_per_call(out)
+        got = inclusive_counts(out)
     sizes = model_counts(binary)
     return per_item(got, sizes), sizes, profile
 
@@ -137,17 +149,18 @@ def git(binary) -> str:
 
 
 def markdown(runs: list[tuple[str, dict]], sizes: dict, wall: str) -> str:
-    L = ["# Instructions and cache misses per time step, per kernel (`make bench-step`)", "",
+    L = ["# Instructions and cache misses per time step, per phase (`make bench-step`)", "",
          f"{datetime.date.today()}, {records.cpu_model()}. Model: theta30 (21.4, 10), 40 x 20 d, h_e 0.3 d, lumped, one thread: "
          f"{sizes['DOF']} DOF, {sizes['nodes']} nodes, {sizes['interfaces']} interfaces; valgrind callgrind with "
-         f"its cache simulation, {STEPS} steps per kernel in the profile's interleaved rounds. Counts per call, "
-         "divided by what each kernel loops over; D1/LL = first/last-level data-cache misses (reads + writes).", "",
-         "| binary | kernel | instructions | D1 misses | LL misses |", "|---|---|---|---|---|"]
+         f"its cache simulation, `enamel-dem profile --steps {STEPS}` with its warm-up. Inclusive counts per step "
+         "divided by what each phase loops over (the law: per call); D1/LL = first/last-level data-cache misses "
+         "(reads + writes).", "",
+         "| binary | phase | instructions | D1 misses | LL misses |", "|---|---|---|---|---|"]
     for label, items in runs:
         for what, c in items.items():
             L.append(f"| {label} | {what} | {c['Ir']:.1f} | {c['D1mr'] + c['D1mw']:.2f} | {c['DLmr'] + c['DLmw']:.3f} |")
     if len(runs) == 2:
-        L += ["", "| kernel | instructions, second / first |", "|---|---|"]
+        L += ["", "| phase | instructions, second / first |", "|---|---|"]
         for what in (w for w in runs[0][1] if w in runs[1][1]):
             L.append(f"| {what} | {runs[1][1][what]['Ir'] / runs[0][1][what]['Ir']:.3f} |")
     L += ["", "Wall-clock profile of the first binary under valgrind (times are valgrind's, for the shares only):", "",

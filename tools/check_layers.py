@@ -18,7 +18,7 @@ LAYERS = [
     ("base", ["version", "exit_codes", "errors", "git_hash", "file_io"]),
     ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params"]),
     ("geometry", ["geometry", "far_field"]),
-    ("plain data", ["state"]),
+    ("plain data", ["state", "step_timers"]),
     ("loops over the data", ["kernels", "node_blocks", "loading_rate", "measurements", "static_solve"]),
     ("schemes and set-up", ["integrators", "integrators/step_parts", "integrators/node_rows",
                             "integrators/slice_outputs", "integrators/newmark", "integrators/lumped",

@@ -110,12 +110,12 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   return exit_code::ok;
 }
 
-// Time each kernel on the case's model (profile.hpp) and print the table; writes nothing else.
+// Time the step's phases on the case's model (profile.hpp) and print the table; writes nothing else.
 int runProfile(const CaseArgs& args, long warmup, long steps) {
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
   if (int rc = checkMemory(p)) return rc;
   Simulation sim(p);
-  std::printf("%s", formatProfileMarkdown(profileKernels(sim, warmup, steps)).c_str());
+  std::printf("%s", formatProfileMarkdown(profileStep(sim, warmup, steps)).c_str());
   return exit_code::ok;
 }
 
@@ -284,11 +284,12 @@ int main(int argc, char** argv) {
   CaseArgs profileArgs;
   long profileWarmup = 200, profileSteps = 100;
   CLI::App* profile = app.add_subcommand(
-      "profile", "time each kernel of the time step on the case's model (integrator lumped) and print a Markdown "
-                 "table: s/step, bytes moved per step, achieved GB/s next to a triad measured in the same run");
+      "profile", "run the time step on the case's model with its phase timers on and print a Markdown table: each "
+                 "phase's ms/step and share of the step, bytes moved per step and achieved GB/s next to a triad "
+                 "measured in the same run");
   profileArgs.addTo(profile);
   profile->add_option("--warmup", profileWarmup, "steps run before timing")->check(CLI::NonNegativeNumber);
-  profile->add_option("--steps", profileSteps, "steps timed per kernel")->check(CLI::PositiveNumber);
+  profile->add_option("--steps", profileSteps, "steps timed")->check(CLI::PositiveNumber);
 
   CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
 

@@ -12,6 +12,7 @@
 #include "errors.hpp"  // IntegratorError, SolverError (kept here for the files that include them through this one)
 #include "kernels.hpp"  // InterfaceSchedule
 #include "state.hpp"
+#include "step_timers.hpp"
 
 namespace enamel {
 
@@ -51,6 +52,11 @@ class Integrator {
   virtual const InterfaceSchedule* interfaceSchedule() const { return nullptr; }
   /// One line on the scheme's own choices (mass scaling, damping), for the output's provenance.
   virtual std::string describe() const { return name(); }
+  /// Where advance books the time of its phases (step_timers.hpp; null, the default: nowhere).
+  void setTimers(StepTimers* timers) { timers_ = timers; }
+
+ protected:
+  StepTimers* timers_ = nullptr;
 };
 
 /// A scheme's factory: the scheme set up for these operators.

@@ -136,6 +136,8 @@ double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElast
 // A due interface: the law at its opening (history updated) and the drift from which it is due again. Off the
 // elastic branch it is due at every step, and `correction` is its force beyond the elastic one (the law's minus
 // elasticForceOnB): returns true; on the elastic branch its force is the elastic one: returns false.
+// Not inlined: at most steps few interfaces are due, and addInterfaceCorrectionsOfSliceScheduled is flattened,
+// which would otherwise inline the law into its scan of the schedule.
 [[gnu::noinline]] bool evaluateDueInterface(const cohesive::Law& law, const cohesive::SliceInterface& g,
                                             const double* qA, const double* qB, double drift, double& lambdaMax,
                                             double& due, int& failed, cohesive::Vec3& correction) {
@@ -231,43 +233,6 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
   return pass;
 }
 
-// Not inlined: the profile's "interfaces" kernel, which bench/step_instructions.py finds by its name.
-[[gnu::noinline]] int computeInterfaceCorrectionsScheduled(const Model& m, const cohesive::Law& law,
-                                                           const Operators& ops, const VecX& q,
-                                                           std::vector<double>& lambdaMax,
-                                                           InterfaceSchedule& schedule, VecX& f) {
-  f.resize(m.numDofs());
-  int failed = 0;
-  long evaluated = 0;
-#pragma omp parallel reduction(+ : failed, evaluated)
-  {
-    std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
-#pragma omp for schedule(static)
-    for (int k = 0; k < m.numSlices; ++k) {
-      const SliceCorrections pass = addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(),
-                                                                            schedule, wrench.data(), evaluated);
-      failed += pass.failed;
-      const int firstNode = ops.sliceNodeStart[k];
-      if (!pass.wrench) std::fill(wrench.begin(), wrench.begin() + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
-      for (int dof = 6 * firstNode; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) f[dof] = -wrench[dof - 6 * firstNode];
-    }
-  }
-  schedule.evaluated = evaluated;
-  return failed;
-}
-
-int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
-                                        const NodeBlockMatrix& elasticBlocks, const VecX& q,
-                                        std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f) {
-  const int failed = computeInterfaceCorrectionsScheduled(m, law, ops, q, lambdaMax, schedule, f);
-  Vec6 elastic;
-  for (int R = 0; R < m.numNodes(); ++R) {
-    multiplyBlockRowSplit<kInterfaceGroups>(elasticBlocks, R, q.data(), elastic);
-    f.segment<6>(6 * R) = elastic + f.segment<6>(6 * R);
-  }
-  return failed;
-}
-
 cohesive::Vec3 computeLocalOpening(const Model& m, const VecX& q, int i) {
   const int A = m.ifaceNodes[i][0], B = m.ifaceNodes[i][1];
   const auto& g = m.ifaceGeom[i];
@@ -295,44 +260,6 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
     }
   }
   return failed;
-}
-
-// --- positions ---------------------------------------------------------------------------------------
-// Not inlined: the profile times it alone, and bench/step_instructions.py finds it by its name.
-[[gnu::noinline]] PositionMove advancePositions(VecX& q, const VecX& v, double dt) {
-  // Two DOFs at a time with the maxima in three independent pairs per block of six (a maximum is exact, so
-  // the result equals the one-at-a-time loop's whatever the grouping or the thread count); the same
-  // q + dt v per DOF.
-  using Pair = DoublePair;
-  double* x = q.data();
-  const double* w = v.data();
-  const Eigen::Index n = q.size(), blocks = n / 6;
-  const Pair step2 = {dt, dt};
-  auto absMax = [](Pair m, Pair a) {
-    const Pair mag = a < 0 ? -a : a;
-    return mag > m ? mag : m;
-  };
-  double largestStep = 0, largestValue = 0;
-#pragma omp parallel for schedule(static) reduction(max : largestStep, largestValue)
-  for (Eigen::Index b = 0; b < blocks; ++b) {
-    Pair s[3], y[3], ms = {0, 0}, mv = {0, 0};
-    for (int j = 0; j < 3; ++j) {
-      const Eigen::Index i = 6 * b + 2 * j;
-      s[j] = step2 * Pair{w[i], w[i + 1]};
-      y[j] = Pair{x[i], x[i + 1]} + s[j];
-      x[i] = y[j][0], x[i + 1] = y[j][1];
-    }
-    for (int j = 0; j < 3; ++j) ms = absMax(ms, s[j]), mv = absMax(mv, y[j]);
-    largestStep = std::max(largestStep, std::max(ms[0], ms[1]));
-    largestValue = std::max(largestValue, std::max(mv[0], mv[1]));
-  }
-  for (Eigen::Index i = 6 * blocks; i < n; ++i) {  // a length not a multiple of 6 (not a model's)
-    const double step = dt * w[i];
-    x[i] += step;
-    largestStep = std::max(largestStep, std::abs(step));
-    largestValue = std::max(largestValue, std::abs(x[i]));
-  }
-  return PositionMove{largestStep, largestValue};
 }
 
 // --- rod elements --------------------------------------------------------------------------------------

@@ -91,23 +91,6 @@ struct SliceCorrections {
 SliceCorrections addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
                                             const double* q, double* lambdaMax, InterfaceSchedule& schedule,
                                             double* wrench, long& evaluated);
-/// f_corr = -(the wrench of addInterfaceCorrectionsOfSliceScheduled) over all slices: the profile's
-/// "interfaces" kernel, the interface pass as the lumped step runs it. Returns the number of failed interfaces.
-int computeInterfaceCorrectionsScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
-                                         const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule,
-                                         VecX& f);
-/// f_iface = K_I q + f_corr (the lumped step's interface forces, as one vector: the tests). Returns the number
-/// of failed interfaces.
-int computeForcesForInterfacesScheduled(const Model& m, const cohesive::Law& law, const Operators& ops,
-                                        const NodeBlockMatrix& elasticBlocks, const VecX& q,
-                                        std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f);
-/// What a position update moved: the largest |dt v_i| added and the largest |q_i| after it.
-struct PositionMove {
-  double largestStep = 0, largestValue = 0;
-};
-/// q += dt v over all DOF (threaded): the explicit schemes' position update.
-PositionMove advancePositions(VecX& q, const VecX& v, double dt);
-
 /// Stress of rod element e for the brittle check (units of E_r), as case key rod_stress defines it (default
 /// beam::maxTensileStress of its local end forces).
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e);

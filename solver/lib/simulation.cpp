@@ -90,13 +90,27 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   return st;
 }
 
-/// One time step: the scheme's step; delete overloaded rods; measure the crack when something broke.
+/// One time step: the scheme's step; book the interfaces' dissipation; check the rods' stresses and delete the
+/// overloaded ones; measure the crack when something broke. Each lap books the calls before it to their phase.
 void Simulation::step() {
+  PhaseLaps laps(timers_);
   const int failedBefore = state.failedInterfaces;
   integrator->advance(model, materials, ops, state);
+  laps.lap(StepPhase::Advance);
   bookInterfaceDissipation(model, materials.law, state);
+  laps.lap(StepPhase::InterfaceDissipation);
+  checkRodStresses();
+  laps.lap(StepPhase::DeletionCheck);
   const int deleted = deleteOverloadedBeams();
+  laps.lap(StepPhase::Deletions);
   if (deleted > 0 || state.failedInterfaces != failedBefore) state.crackAdvance = measureCrackAdvance();
+  laps.lap(StepPhase::CrackMeasure);
+  if (timers_) ++timers_->steps;
+}
+
+void Simulation::setTimers(StepTimers* timers) {
+  timers_ = timers;
+  integrator->setTimers(timers);
 }
 
 namespace {
@@ -131,11 +145,15 @@ void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool c
 // A deleted element's stiffness (and its stiffness damping) is removed; its consistent mass is replaced by
 // the lumped mass of the same element, so no material mass vanishes and no node is left massless (the paper
 // subtracts M_e, eq. 17; see docs/model.md, departures). The energy it held is booked as rod fracture energy.
+void Simulation::checkRodStresses() {
+  if (!materials.rodsBreakable) return;
+  checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
+                            stressSchedule_, beamStressRatio_);
+}
+
 int Simulation::deleteOverloadedBeams() {
   lastDeleted.clear();
   if (!materials.rodsBreakable) return 0;
-  checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
-                            stressSchedule_, beamStressRatio_);
   lastDeleted =
       findOverloadedBeams(beamStressRatio_, state.beamBroken, materials.deletionRule, stressSchedule_.largestRatio);
   if (lastDeleted.empty()) return 0;

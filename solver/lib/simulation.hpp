@@ -14,6 +14,7 @@
 #include "setup.hpp"         // measureTransverseModulus
 #include "state.hpp"
 #include "static_solve.hpp"  // solveStaticPrescribed, computeFirstDamageDisplacement
+#include "step_timers.hpp"
 
 namespace enamel {
 
@@ -63,11 +64,18 @@ class Simulation {
   std::vector<int> lastDeleted;  // rod elements deleted in the last step
 
   /// One time step: the scheme's step (forces, velocities, positions, boundary conditions, the work of the
-  /// grips, damping work), then delete overloaded rods and measure the crack when something broke.
+  /// grips, damping work), then book the interfaces' dissipation, check the rods' stresses, delete overloaded
+  /// rods and measure the crack when something broke.
   void step();
-  /// Delete the rod elements whose stress reached their strength (rule: deletion_rule), book the energy
-  /// they held, and let the integrator update. Returns how many.
+  /// The deletion check: each rod element's stress ratio sigma / sigma_ru as the schedule requires it
+  /// (kernels.hpp checkStressRatiosForBeams; nothing when rods are unbreakable).
+  void checkRodStresses();
+  /// Delete the rod elements whose stress ratio at the last check reached 1 (rule: deletion_rule), book the
+  /// energy they held, and let the integrator update. Returns how many.
   int deleteOverloadedBeams();
+  /// Where step() books the time of its phases and its scheme's (step_timers.hpp: `enamel-dem profile`);
+  /// null, the default: nowhere. The timers must outlive the steps they time.
+  void setTimers(StepTimers* timers);
   /// After a checkpoint restored state.deletionOrder into a freshly built simulation: remove those rod
   /// elements from K and M in the same order as the run did (so both are the same bit for bit) and let the
   /// integrator update once. Energies are not booked again (they are part of the restored state).
@@ -101,6 +109,7 @@ class Simulation {
  private:
   std::vector<double> beamStressRatio_;  // scratch: sigma / sigma_ru per rod element
   StressCheckSchedule stressSchedule_;   // scratch: which rod elements the deletion check computes
+  StepTimers* timers_ = nullptr;         // setTimers
 };
 
 }  // namespace enamel

@@ -40,6 +40,35 @@ VecX pseudoRandomField(int n, double amp) {
   return q;
 }
 
+// f_iface as the lumped step applies it: K_I q (elasticInterfaceBlocks, in its node rows) less, per slice, the
+// wrench W of its interfaces beyond their elastic force (addInterfaceCorrectionsOfSliceScheduled, the call the
+// step makes per slice; nothing where it wrote none), the slices in parallel. schedule.evaluated: the interfaces
+// the law saw. Returns the number of failed interfaces.
+int scheduledInterfaceForces(const Model& m, const cohesive::Law& law, const Operators& ops, const NodeBlockMatrix& KI,
+                             const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f) {
+  f.resize(m.numDofs());
+  int failed = 0;
+  long evaluated = 0;
+#pragma omp parallel reduction(+ : failed, evaluated)
+  {
+    std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
+#pragma omp for schedule(static)
+    for (int k = 0; k < m.numSlices; ++k) {
+      const SliceCorrections pass = addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(),
+                                                                            schedule, wrench.data(), evaluated);
+      failed += pass.failed;
+      for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
+        Vec6 elastic;
+        multiplyBlockRowSplit<kInterfaceGroups>(KI, node, q.data(), elastic);
+        const double* W = wrench.data() + 6 * (node - ops.sliceNodeStart[k]);
+        for (int j = 0; j < 6; ++j) f[6 * node + j] = pass.wrench ? elastic[j] - W[j] : elastic[j];
+      }
+    }
+  }
+  schedule.evaluated = evaluated;
+  return failed;
+}
+
 }  // namespace
 
 // f_iface from the gather against the nodal wrenches of computeInterfaceForces summed interface by
@@ -168,7 +197,9 @@ TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
   }
 }
 
-// The scheduled interface pass (InterfaceSchedule) along a path that fails some interfaces and comes back: the
+// The scheduled interface pass (InterfaceSchedule: advanceInterfaceSchedule, then per slice
+// addInterfaceCorrectionsOfSliceScheduled and K_I q, as the lumped step calls them) along a path that fails some
+// interfaces and comes back: the
 // same histories and failed counts as evaluating every interface by the law, forces within round-off of it (and of the elastic blocks' tolerance, kInterfaceBlockTolerance);
 // a schedule started afresh part-way (a restart) gives the same forces bit for bit; no thread count matters.
 // `keys`: further case keys (the mixed-mode law's shear_strength_ratio, whose lambda weighs shear by 1/beta^2).
@@ -197,7 +228,7 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
     if (t == restartAt) lmFresh = lmSched;
     const int failedLaw = computeForcesForInterfaces(m, law, sim.ops, q, lmLaw, true, fLaw);
     advanceInterfaceSchedule(m, law, sim.ops, moved, q.cwiseAbs().maxCoeff(), sched);
-    const int failedSched = computeForcesForInterfacesScheduled(m, law, sim.ops, KI, q, lmSched, sched, fSched);
+    const int failedSched = scheduledInterfaceForces(m, law, sim.ops, KI, q, lmSched, sched, fSched);
     evaluated += sched.evaluated;
     ASSERT_EQ(failedSched, failedLaw) << "step " << t;
     for (int i = 0; i < m.numInterfaces(); ++i) ASSERT_EQ(lmSched[i], lmLaw[i]) << "step " << t << ", interface " << i;
@@ -209,7 +240,7 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
         << "step " << t;
     if (t >= restartAt) {  // lmFresh holds the histories before this step's update, as a checkpoint would
       advanceInterfaceSchedule(m, law, sim.ops, t == restartAt ? INFINITY : moved, q.cwiseAbs().maxCoeff(), fresh);
-      computeForcesForInterfacesScheduled(m, law, sim.ops, KI, q, lmFresh, fresh, fFresh);
+      scheduledInterfaceForces(m, law, sim.ops, KI, q, lmFresh, fresh, fFresh);
       ASSERT_EQ(fFresh, fSched) << "step " << t;
       ASSERT_EQ(lmFresh, lmSched) << "step " << t;
     }
@@ -355,32 +386,55 @@ TEST(Kernels, NodeBlocksShareBlocksThatAgreeToTheTolerance) {
   EXPECT_TRUE(tolerant.split.empty()) << "these blocks couple the groups";
 }
 
-// The position update (two DOFs at a time, maxima in pairs) gives the one-DOF-at-a-time loop's q bit for bit
-// and its exact maxima, on lengths that are and are not multiples of 6, with signs of both kinds, at 1 and 2
-// threads.
-TEST(Kernels, PositionUpdateEqualsTheScalarLoop) {
+// The lumped step's position update (in its node pass, two DOFs at a time, the maxima in pairs): q_{n+1} of every
+// free DOF is q_n + dt v_{n+1/2} (with FMA, where the node rows' copy for this CPU has it, rounded once: either way
+// the one-DOF-at-a-time loop's value bit for bit), the grips' q is shape U(t_{n+1}), and the move bound the
+// schedules rely on (lastStepMoveBound) holds every DOF's move and is the documented sum of the exact maxima
+// max |dt v|, max |q|; the same q, v at 1 and 2 threads.
+TEST(Kernels, LumpedStepMovesPositionsByDtTimesTheHalfStepVelocity) {
   const int before = omp_get_max_threads();
-  for (int n : {6, 12, 600, 601, 605}) {
-    const VecX q0 = pseudoRandomField(n, 3.0) - VecX::Constant(n, 1.0), v = pseudoRandomField(n, 2.0).reverse();
-    const double dt = 0.0313;
-    VecX expected = q0;
-    double step = 0, value = 0;
-    for (int i = 0; i < n; ++i) {
-      const double s = dt * v[i];
-      expected[i] += s;
-      step = std::max(step, std::abs(s));
-      value = std::max(value, std::abs(expected[i]));
+  std::vector<VecX> qAt, vAt;  // per thread count: q and v_{n+1/2} after the steps
+  for (int threads : {1, 2}) {
+    Simulation sim(smallCase("integrator = \"lumped\"\n"));
+    omp_set_num_threads(threads);
+    State& s = sim.state;
+    const double delta0 = sim.materials.law.delta0(), dt = sim.integrator->timeStep();
+    s.q = pseudoRandomField(sim.model.numDofs(), 0.3 * delta0);  // elastic: no interface past delta0
+    s.v = pseudoRandomField(sim.model.numDofs(), 1e-3).reverse();
+    sim.integrator->initialise(sim.model, sim.materials, sim.ops, s);
+    double largestShape = 0;
+    for (double shape : sim.ops.prescribedShape) largestShape = std::max(largestShape, std::abs(shape));
+    for (int n = 0; n < 5; ++n) {
+      const VecX q0 = s.q;
+      const double U0 = s.appliedDisplacement;
+      sim.step();
+      const VecX& v = s.vHalf;  // v_{n+1/2}
+      double largestStep = 0, largestValue = 0, moved = 0;
+      for (int i = 0; i < sim.model.numDofs(); ++i) {
+        const double step = dt * v[i], twice = q0[i] + step, once = std::fma(dt, v[i], q0[i]);
+        largestStep = std::max(largestStep, std::abs(step));
+        moved = std::max(moved, std::abs(s.q[i] - q0[i]));
+        if (sim.ops.dofToFree[i] >= 0) {
+          ASSERT_TRUE(s.q[i] == twice || s.q[i] == once) << "step " << n << ", DOF " << i;
+          largestValue = std::max(largestValue, std::abs(s.q[i]));
+        } else {
+          largestValue = std::max(largestValue, std::abs(twice));  // the node pass's q, before the grips' own
+        }
+      }
+      for (std::size_t g = 0; g < sim.ops.prescribedDofs.size(); ++g)
+        ASSERT_EQ(s.q[sim.ops.prescribedDofs[g]], sim.ops.prescribedShape[g] * s.appliedDisplacement);
+      const double U1 = s.appliedDisplacement;
+      const double largest = std::max({largestValue, largestShape * std::abs(U1), largestShape * std::abs(U0)});
+      const double bound = std::max(largestStep, largestShape * std::abs(U1 - U0)) * (1.0 + 1e-12) + std::ldexp(largest, -52);
+      EXPECT_GE(sim.integrator->lastStepMoveBound(), moved) << "step " << n;
+      EXPECT_EQ(sim.integrator->lastStepMoveBound(), bound) << "step " << n;
     }
-    for (int threads : {1, 2}) {
-      omp_set_num_threads(threads);
-      VecX q = q0;
-      const PositionMove move = advancePositions(q, v, dt);
-      for (int i = 0; i < n; ++i) ASSERT_EQ(q[i], expected[i]) << "n " << n << ", DOF " << i;
-      EXPECT_EQ(move.largestStep, step) << "n " << n;
-      EXPECT_EQ(move.largestValue, value) << "n " << n;
-    }
+    qAt.push_back(s.q);
+    vAt.push_back(s.vHalf);
   }
   omp_set_num_threads(before);
+  EXPECT_EQ(qAt[0], qAt[1]);
+  EXPECT_EQ(vAt[0], vAt[1]);
 }
 
 TEST(Kernels, FailedFactorisationIsARunFailure) {

@@ -69,24 +69,51 @@ def test_within_the_bound_needs_no_quasi_static_warning():
     assert not within_bound(dict(ok, status="failed"))
 
 
-def test_profile_times_every_kernel_and_refuses_the_paper_scheme(enamel):
-    """`enamel-dem profile` (what `make bench` writes into bench/profile.md): one table row per kernel with a
-    positive time, the step's parts no larger than the step, in interleaved rounds; the `paper` scheme is refused
-    as bad input. Correctness of the report only: no speed is asserted."""
+def profile_rows(stdout: str) -> dict:
+    """{phase: (depth, ms/step, laps/step)} of one `enamel-dem profile` table (depth 0: the step)."""
+    rows = {}
+    for line in stdout.splitlines():
+        cells = line.split("|")
+        if line.startswith("| ") and not line.startswith("| phase"):
+            name = cells[1].rstrip()
+            laps = cells[4].strip()
+            rows[name.strip()] = ((len(name) - len(name.lstrip()) - 1) // 2, float(cells[2]),
+                                  float(laps) if laps != "-" else None)
+    return rows
+
+
+def test_profile_times_each_phase_of_either_scheme(enamel):
+    """`enamel-dem profile` (what `make bench` writes into bench/profile.md): the real step run with its phase
+    timers, one row per phase of the scheme's step and of Simulation::step under the step, each timed once per
+    step (the lumped slice pass's parts per slice), the parts of a phase no longer than it; the `paper` scheme's
+    own phases. Correctness of the report only: no speed is asserted."""
     case = str(ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml")
     args = [str(enamel), "profile", case, "--preset", "ci", "--set", "w_s_over_d=8", "--set", "h_s_over_d=4",
-            "--set", "threads=1", "--steps", "10"]
-    r = subprocess.run(args, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
-    assert "10 steps per kernel in 5 interleaved rounds (median round)" in r.stdout
-    rows = {line.split("|")[1].strip(): float(line.split("|")[2]) for line in r.stdout.splitlines()
-            if line.startswith("| ") and not line.startswith("| kernel")}
-    assert set(rows) == {"step", "advance", "interfaces", "nodes", "(positions)", "check and rest",
-                         "(stress check, every element)"}
-    assert all(t >= 0 for t in rows.values()) and rows["step"] > 0 and rows["interfaces"] > 0
-    assert rows["nodes"] + rows["interfaces"] >= rows["advance"] * (1 - 1e-3)  # printed to 4 digits
-    r = subprocess.run(args + ["--set", 'integrator="paper"'], capture_output=True, text=True, timeout=300)
-    assert r.returncode == EXIT["out_of_range"] and "integrator 'paper' is not profiled (allowed: lumped)" in r.stderr
+            "--set", "threads=1", "--steps", "10", "--warmup", "20"]
+    common = {"step", "advance", "interface dissipation", "deletion check", "deletions", "crack measure"}
+    schemes = {"lumped": {"interface schedule", "slice pass", "interfaces", "nodes", "slice writes", "barrier",
+                          "grips and work", "clock and grips"},
+               "paper": {"positions", "boundary conditions", "interface forces", "rod forces", "accelerations",
+                         "velocities", "reactions and work"}}
+    for scheme, own in schemes.items():
+        r = subprocess.run(args + ["--set", f'integrator="{scheme}"'], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        assert f"1 thread(s), scheme {scheme}, 10 steps timed after 20 warm-up steps" in r.stdout
+        rows = profile_rows(r.stdout)
+        assert set(rows) == common | own, scheme
+        assert all(t >= 0 for _, t, _ in rows.values()) and rows["step"][1] > 0 and rows["advance"][1] > 0
+        names = list(rows)
+        parent = {name: next(p for p in reversed(names[:i]) if rows[p][0] == rows[name][0] - 1)
+                  for i, name in enumerate(names) if rows[name][0] > 0}
+        for name in parent:
+            assert rows[name][2] >= 1 and rows[name][2] == int(rows[name][2]), (name, rows[name][2])
+        for p in set(parent.values()):
+            parts = sum(rows[c][1] for c in parent if parent[c] == p)
+            assert parts <= rows[p][1] * (1 + 1e-3), (p, parts)  # printed to 4 digits
+        assert parent["deletion check"] == "step" and rows["advance"][2] == 1 and rows["deletion check"][2] == 1
+        if scheme == "lumped":
+            assert parent["nodes"] == "slice pass" and parent["slice pass"] == "advance"
+    assert rows["rod forces"][2] == 1
 
 
 def start_paper_preset(enamel, tmp_path):
@@ -144,17 +171,24 @@ def test_paper_preset_passes_sigterm_on_to_the_solver(enamel, tmp_path):
 
 
 def test_bench_step_reads_callgrind_annotate_columns():
-    """`make bench-step` reads callgrind_annotate's event columns, '.' and a bare 0 being zeros."""
+    """`make bench-step` reads callgrind_annotate's event columns, '.' and a bare 0 being zeros, and divides each
+    phase's inclusive counts per step by what it loops over (the law: per call)."""
     from bench.step_instructions import _counts, per_item
     line = ("   28,224,987 ( 1.60%)    201,687 ( 0.64%)     35,680 ( 0.24%)  .                  0           "
-            "< ???:enamel::profileKernels(enamel::Simulation&, long, long) (10x) [/x/enamel-dem]")
+            "< ???:enamel::profileStep(enamel::Simulation&, long, long) (10x) [/x/enamel-dem]")
     assert _counts(line) == [28224987, 201687, 35680, 0, 0]
     star = line.replace("< ???", "*  ???")
     assert _counts(star) == [28224987, 201687, 35680, 0, 0]
-    ev = lambda ir: dict(Ir=ir, D1mr=0, D1mw=0, DLmr=0, DLmw=0)  # noqa: E731
-    got = {"step": ev(1100), "advance": ev(1000), "interfaces": ev(600), "positions": ev(100)}
+    ev = lambda ir, calls: dict(Ir=ir, D1mr=0, D1mw=0, DLmr=0, DLmw=0, calls=calls)  # noqa: E731
+    # 5 steps of a model of 10 DOF and 2 nodes, 4 slices (node rows called per slice), the law called 3 times
+    got = {"step": ev(1100, 5), "advance": ev(1000, 5), "slice pass": ev(900, 5), "node rows": ev(600, 20),
+           "law": ev(90, 3)}
     items = per_item(got, {"DOF": 10, "nodes": 2, "interfaces": 3})
-    assert items["node rows and positions per node"]["Ir"] == 200 and items["interfaces per interface"]["Ir"] == 200
+    assert items["step per DOF"]["Ir"] == 22 and items["advance per DOF"]["Ir"] == 20
+    assert items["slice pass per node"]["Ir"] == 90 and items["node rows per node"]["Ir"] == 60  # per step, not per call
+    assert items["law per call"]["Ir"] == 30
+    del got["law"]  # no interface due: no row
+    assert "law per call" not in per_item(got, {"DOF": 10, "nodes": 2, "interfaces": 3})
 
 
 def test_bench_G_is_the_solver_default_unless_given(enamel):

@@ -1,7 +1,7 @@
 """bench/profile_pair.py, the interleaved profile of two solver binaries, without the `paper` preset: its parse of
-`enamel-dem profile`'s Markdown (a captured output, and the binary's own at the ci preset), the medians and
-new / old ratios on made-up numbers with a known answer, the page it writes, and a failing binary. Correctness
-only: no timing is asserted here."""
+`enamel-dem profile`'s Markdown (captured outputs of the present form and an older binary's, and the binary's own
+at the ci preset), an old profile against a new one, the medians and new / old ratios on made-up numbers with a
+known answer, the page it writes, and a failing binary. Correctness only: no timing is asserted here."""
 import math
 
 import pytest
@@ -9,8 +9,30 @@ import pytest
 from bench import profile_pair as pp
 
 # `enamel-dem profile paper_cases/theta30_s21.4_e10_cv0.toml --preset ci --warmup 5 --steps 3` with
-# bench.run_bench.PROFILE_SETS and threads=1 (solver e22f90a's format).
+# bench.run_bench.PROFILE_SETS and threads=1: the phases of the real step, in ms/step (2026-12-06, AMD EPYC).
 CAPTURED = """\
+4488 DOF, 1 thread(s), scheme lumped, 3 steps timed after 5 warm-up steps: 0.03673 ms/step, 122.2 M DOF-updates/s per core; triad 13.2 GB/s; timers: 174 laps per step, a clock read 26 ns
+
+| phase | ms/step | share of step | laps/step | MB/step | GB/s | % of triad | what |
+|---|---|---|---|---|---|---|---|
+| step | 0.03673 | 100% | - | 0.3 | 8.1 | 62% | Simulation::step, timed around each call; the phases below are its parts, each timed around the calls the step makes for it |
+|   advance | 0.03446 | 94% | 1 | - | - | - | the scheme's step (Integrator::advance) |
+|     interface schedule | 4.667e-05 | 0% | 1 | - | - | - | advanceInterfaceSchedule: the drift of the displacements, which interfaces may be due |
+|     slice pass | 0.0333 | 91% | 1 | 0.3 | 8.7 | 66% | computeForcesAndAdvanceVelocities: the parallel pass over the slices, forces then velocities and positions |
+|       interfaces | 0.001732 | 5% | 54 | 0.0 | 8.8 | 67% | per slice, mean over the threads: addInterfaceCorrectionsOfSliceScheduled, the law where the schedule makes an interface due and, off the elastic branch, its force beyond the elastic one (the step: the law saw 0% of the interfaces per step) |
+|       nodes | 0.02433 | 66% | 54 | 0.3 | 11.3 | 86% | per slice, mean over the threads: advanceNodesOfSlice, per node K_I q, K q, K v, v_{n+1/2}, grip residuals, damping sums, q_{n+1} = q_n + dt v_{n+1/2} |
+|       slice writes | 0.002452 | 7% | 55 | - | - | - | per slice, mean over the threads: SliceOutputs, v_{n+1/2} and q_{n+1} written over the old values (the waiting slices after the barrier) |
+|       barrier | 0.001476 | 4% | 1 | - | - | - | mean over the threads: waiting for the other threads at the pass's barrier |
+|     grips and work | 0.0007477 | 2% | 2 | - | - | - | computeReactions, addWorkOfGrips, addDampingWork: the grips' reactions and work, the damping work |
+|     clock and grips | 0.0002707 | 1% | 1 | - | - | - | moveOfStep, advanceClock, prescribeDisplacements, boundOfMove: t_{n+1}, q of the grips, the step's move |
+|   interface dissipation | 4.033e-05 | 0% | 1 | - | - | - | bookInterfaceDissipation (mixed-mode law only; nothing to book otherwise) |
+|   deletion check | 0.002044 | 6% | 1 | 0.0 | 3.1 | 24% | checkRodStresses: the rod stress check as scheduled (0% of the rod elements computed per step) |
+|   deletions | 3.7e-05 | 0% | 1 | - | - | - | deleteOverloadedBeams: the overloaded rod elements found and, where there are any, deleted |
+|   crack measure | 2.967e-05 | 0% | 1 | - | - | - | measureCrackAdvance, when something failed or broke |
+"""
+# The same of an older binary (solver e22f90a's format: kernels in s/step, some of them timed alone), as
+# `--against` may be given one.
+CAPTURED_OLD = """\
 4488 DOF, 1 thread(s), 5 steps per kernel in 5 interleaved rounds (median round): 5.107e-05 s/step, 87.9 M DOF-updates/s per core; triad 32.8 GB/s
 
 | kernel | s/step | share of step | MB/step | GB/s | % of triad | what |
@@ -45,14 +67,41 @@ NEW = {"s_per_step": 1.0, "mdofs_per_core": 45.0, "advance": 0.9, "interfaces": 
        "check and rest": 0.1}
 
 
-def test_parse_reads_the_header_and_the_kernels():
+PHASES = ("advance", "interface schedule", "slice pass", "interfaces", "nodes", "slice writes", "barrier",
+          "grips and work", "clock and grips", "interface dissipation", "deletion check", "deletions", "crack measure")
+
+
+def test_parse_reads_the_header_and_the_phases_in_seconds():
     p = pp.parse(CAPTURED)
+    assert p.keys() == {"dof", "threads", "s_per_step", "mdofs_per_core", "step", *PHASES}
+    assert (p["dof"], p["threads"], p["mdofs_per_core"]) == (4488, 1, 122.2)
+    ms = {"step": 0.03673, "advance": 0.03446, "interfaces": 0.001732, "nodes": 0.02433, "crack measure": 2.967e-05}
+    for k, v in ms.items():
+        assert p[k] == pytest.approx(1e-3 * v, rel=1e-12), k
+    assert p["s_per_step"] == p["step"]
+    with pytest.raises(ValueError, match="no profile header"):
+        pp.parse(CAPTURED.split("\n", 1)[1])
+    with pytest.raises(ValueError, match="no profile table"):
+        pp.parse(CAPTURED.split("\n\n", 1)[0])
+
+
+def test_parse_reads_an_older_binarys_kernels():
+    p = pp.parse(CAPTURED_OLD)
     assert p == {"dof": 4488, "threads": 1, "s_per_step": 5.107e-05, "mdofs_per_core": 87.9, "step": 5.107e-05,
                  "advance": 4.77e-05, "interfaces": 2.155e-05, "nodes": 2.615e-05, "check and rest": 3.368e-06}
     # the kernels timed alone for comparison, "(positions)" and "(stress check, every element)", are not parts
     # of the step and are not read
-    with pytest.raises(ValueError, match="no profile header"):
-        pp.parse(CAPTURED.split("\n", 1)[1])
+
+
+def test_an_old_and_a_new_profile_compare_where_they_share_a_phase():
+    old, new = pp.parse(CAPTURED_OLD), pp.parse(CAPTURED)
+    rounds = [(old, new), (old, new)]
+    assert pp.phases(rounds)[:4] == ["advance", "interfaces", "nodes", "check and rest"]
+    med = pp.medians(rounds)
+    assert "check and rest" in med["old"] and "check and rest" not in med["new"] and "slice pass" not in med["old"]
+    ratio = pp.ratios(med)
+    assert ratio["advance"] == pytest.approx(3.446e-05 / 4.77e-05)
+    assert math.isnan(ratio["check and rest"]) and math.isnan(ratio["slice pass"])
 
 
 def test_parse_reads_the_binarys_own_profile(run):
@@ -62,8 +111,8 @@ def test_parse_reads_the_binarys_own_profile(run):
     assert r.returncode == 0, r.stderr
     p = pp.parse(r.stdout)
     assert p["threads"] == 1 and p["dof"] > 0
-    assert set(p) == {"dof", "threads", "s_per_step", "mdofs_per_core", *pp.KERNELS}
-    assert p["step"] == p["s_per_step"] and all(p[k] >= 0 for k in pp.KERNELS)
+    assert set(p) == {"dof", "threads", "s_per_step", "mdofs_per_core", "step", *PHASES}
+    assert p["step"] == p["s_per_step"] and all(p[k] >= 0 for k in PHASES)
 
 
 def test_profile_args_are_the_bench_profiles():
@@ -126,7 +175,7 @@ def test_main_interleaves_two_binaries(enamel, tmp_path, monkeypatch):
     md = out.read_text()
     assert "1 thread(s)" in md and "2 rounds, old then new in each" in md
     med_rows = {line.split("|")[1].strip(): line for line in md.splitlines() if line.startswith("| ")}
-    for k in ("s_per_step", *pp.KERNELS[1:]):
+    for k in ("s_per_step", *PHASES):
         ratio = float(med_rows[k].split("|")[4])
         assert math.isfinite(ratio) and ratio > 0, med_rows[k]
     assert "x** (medians of the rounds)" in md

@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
 #include "kernels.hpp"
 #include "node_rows.hpp"
 #include "schemes.hpp"
@@ -74,6 +78,11 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
   }
   return std::sqrt(std::max(lambda, 0.0));
 }
+
+// What the node pass's position update moved: the largest |dt v_i| added and the largest |q_i| after it.
+struct PositionMove {
+  double largestStep = 0, largestValue = 0;
+};
 
 // The wrench of a slice whose interfaces the law did not see (all elastic: their forces are in K_I q).
 alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
@@ -165,18 +174,26 @@ class LumpedIntegrator : public Integrator {
     return o.str();
   }
 
+  // The step as the class comment lists it; each lap books the calls before it to their phase (step_timers.hpp).
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    PhaseLaps laps(timers_);
     gatherGrips(ops, s.vHalf, vGripBefore_);  // v_{n-1/2} of the grips, for their reactions
+    laps.lap(StepPhase::GripsAndWork);
+    advanceInterfaceSchedule(m, mat.law, ops, moveBound_, largestValue_, ifaceSchedule_);
+    laps.lap(StepPhase::InterfaceSchedule);
     s.failedInterfaces = computeForcesAndAdvanceVelocities(m, mat, ops, s);
+    laps.lap(StepPhase::SlicePass);
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
+    laps.lap(StepPhase::GripsAndWork);
     const PositionMove move = moveOfStep();
     advanceClock(mat.loading, s, dt_);
     const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
     moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
     largestValue_ = std::max(move.largestValue, largestShape_ * std::abs(s.appliedDisplacement));  // >= max |q_{n+1}|
+    laps.lap(StepPhase::ClockAndGrips);
   }
 
   double lastStepMoveBound() const override { return moveBound_; }
@@ -208,8 +225,8 @@ class LumpedIntegrator : public Integrator {
   // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a
   // slice in a fixed order, so nothing depends on the thread count). Per slice:
   //   the wrench W of its interfaces on its nodes beyond their elastic force: the law's (opening, law, force
-  //     on B) of those the schedule makes due (InterfaceSchedule, kernels.hpp), their history updated at q_n,
-  //     less the elastic force of those off the elastic branch
+  //     on B) of those the schedule (InterfaceSchedule, kernels.hpp; advanced for this step) makes due, their
+  //     history updated at q_n, less the elastic force of those off the elastic branch
   //   per node: K_I q_n (its block row; all the slice's nodes first), then (advanceNode) K q_n and K v_{n-1/2}
   //     (its block rows), r = K q + K_I q - W + b' K v,
   //     v_{n+1/2} = [(1 - a dt/2) v_{n-1/2} - dt M^-1 r] / (1 + a dt/2), and for the grips
@@ -219,7 +236,7 @@ class LumpedIntegrator : public Integrator {
   // v_{n+1/2} and q_{n+1} replace v_{n-1/2} and q_n in place once no slice still to come reads them
   // (SliceOutputs: a slice's rows reach sliceReach_ slices either side; each thread takes one run of
   // consecutive slices, and those its neighbours read wait for the end of the pass). Returns the number of
-  // failed interfaces.
+  // failed interfaces. With timers, each thread laps its slices' phases and books its share, 1 / threads.
   [[gnu::flatten]] int computeForcesAndAdvanceVelocities(const Model& m, const Materials& mat, const Operators& ops, State& s) {
     const cohesive::Law law = mat.law;
     NodeStep step;
@@ -234,7 +251,6 @@ class LumpedIntegrator : public Integrator {
     const double* q = s.q.data();
     const double* v = s.vHalf.data();
     double* lambda = s.lambdaMax.data();
-    advanceInterfaceSchedule(m, law, ops, moveBound_, largestValue_, ifaceSchedule_);
     int failed = 0;
     long evaluated = 0;
 #pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
@@ -242,21 +258,40 @@ class LumpedIntegrator : public Integrator {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
       std::vector<DoublePair> KIq(3 * static_cast<std::size_t>(ops.maxNodesPerSlice));  // the slice's K_I q_n
       SliceOutputs out(ops, s, m.numSlices, sliceReach_, vNext_.data(), qNext_.data());
+      StepTimers mine;
+      PhaseLaps laps(timers_ ? &mine : nullptr);
       for (int k = out.first; k < out.last; ++k) {
         const SliceCorrections pass =
             addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
         failed += pass.failed;
+        laps.lap(StepPhase::SliceInterfaces);
         const SliceOutputs::Slot to = out.slotOf(k);
         // no wrench written: every node reads the same six zeros
         sliceSums_[k] = pass.wrench ? advanceNodesOfSlice(rows_, ops, step, k, q, v, wrench.data(), 6, KIq.data(), to.v, to.q)
                                     : advanceNodesOfSlice(rows_, ops, step, k, q, v, kNoWrench, 0, KIq.data(), to.v, to.q);
+        laps.lap(StepPhase::SliceNodes);
         out.replaceBefore(k);
+        laps.lap(StepPhase::SliceWrites);
       }
 #pragma omp barrier
+      laps.lap(StepPhase::SliceBarrier);
       out.replaceWaiting();
+      laps.lap(StepPhase::SliceWrites);
+      if (timers_) bookShareOfThread(mine);
     }
     ifaceSchedule_.evaluated = evaluated;
     return failed;
+  }
+
+  // timers_ += this thread's seconds / the pass's threads (its laps in full), one thread at a time
+  void bookShareOfThread(const StepTimers& mine) {
+#if defined(_OPENMP)
+    const double share = 1.0 / omp_get_num_threads();
+#else
+    const double share = 1.0;
+#endif
+#pragma omp critical(enamel_step_timers)
+    addShareOfTimers(mine, share, *timers_);
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with

@@ -62,19 +62,28 @@ class PaperIntegrator : public Integrator {
   std::string name() const override { return "paper"; }
   double timeStep() const override { return dt_; }
 
+  // The step as the class comment lists it; each lap books the calls before it to their phase (step_timers.hpp).
   void advance(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
+    PhaseLaps laps(timers_);
     predictVelocities(s);
     advancePositions(s);
+    laps.lap(StepPhase::PaperPositions);
     advanceClock(mat.loading, s, dt_);
     applyBoundaryConditions(ops, mat.loading, dt_, s);
+    laps.lap(StepPhase::PaperBoundaryConditions);
     s.failedInterfaces = computeForcesForInterfaces(m, mat.law, ops, s.q, s.lambdaMax, true, fI_);
+    laps.lap(StepPhase::PaperInterfaces);
     computeForcesForBeams(ops, s);
+    laps.lap(StepPhase::PaperRodForces);
     solveAccelerations(ops, s);
+    laps.lap(StepPhase::PaperAccelerations);
     advanceVelocities(ops, s);
     addDampingWork(s);
+    laps.lap(StepPhase::PaperVelocities);
     computeReactions(ops, s);
     gatherGrips(ops, s.v, vGrip_);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_);
+    laps.lap(StepPhase::PaperReactions);
   }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
