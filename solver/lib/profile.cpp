@@ -85,8 +85,9 @@ ByteCounts countBytes(const Model& m) {
 }  // namespace
 
 KernelProfile profileKernels(Simulation& sim, long warmup, long steps) {
-  if (sim.integrator->name() != "lumped" || !sim.integrator->interfaceSchedule())
-    throw IntegratorError("profile: integrator '" + sim.integrator->name() + "' is not profiled (allowed: lumped)");
+  if (sim.params.integrator != IntegratorScheme::lumped || !sim.integrator->interfaceSchedule())
+    throw IntegratorError("profile: integrator '" + sim.integrator->name() + "' is not profiled (allowed: " +
+                          nameOf(IntegratorScheme::lumped) + ")");
   KernelProfile p;
   p.threads = threadCount();
   p.steps = steps;
