@@ -204,13 +204,13 @@ FIG_COMMON := figures/plotting.py $(wildcard enamel_results/*.py) figures/paper_
 define figure_rule
 $(FIG_OUT)/$(basename $(notdir $(call fig_script,$(1)))).png: $(call fig_script,$(1)) $(FIG_COMMON) \
     $(call run_targets,$($(shell echo $(1) | tr a-z A-Z)_CASES),$($(shell echo $(1) | tr a-z A-Z)_SLOW))
-	$(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
 endef
 $(foreach f,$(FIGURES),$(eval $(call figure_rule,$(f))))
 FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(f)))).png)
 
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
-	$(PYTHON) -m figures.summary_table --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m figures.summary_table --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
 
 figures: check-preset
 	$(call parallel,figures)
@@ -228,7 +228,7 @@ SLURM_CPUS ?= 1
 SLURM_PASS := BUILD_DIR ENAMEL CHECKPOINT_EVERY LOCK_WAIT PYTHON
 slurm_opt = $(if $(2),'--$(1)=$(subst ','\'',$(2))')
 slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
-	$(PYTHON) -m pipeline.slurm_jobs --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.slurm_jobs --preset $(PRESET) --runs $(RUNS) --out $(SLURM_DIR) --solver $(ENAMEL) \
 	  --cpus $(SLURM_CPUS) $(call slurm_opt,partition,$(SLURM_PARTITION)) $(call slurm_opt,account,$(SLURM_ACCOUNT)) \
 	  $(call slurm_opt,time,$(SLURM_TIME)) $(call slurm_opt,mem,$(SLURM_MEM)) $(call slurm_opt,then,$(SLURM_THEN)) \
 	  $(call slurm_opt,signal-seconds,$(SLURM_SIGNAL)) \
@@ -240,7 +240,7 @@ slurm: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 vtk: check-preset
 	@found=0; for h in $(RUNS)/$(PRESET)/*/result.h5; do [ -f "$$h" ] || continue; found=1; \
 	  d=$$(dirname $$h)/vtk; if [ ! -d "$$d" ] || [ "$$h" -nt "$$d" ]; then \
-	    $(PYTHON) -m pipeline.export_vtk $$h $$d || exit 1; touch $$d; fi; done; \
+	    ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.export_vtk $$h $$d || exit 1; touch $$d; fi; done; \
 	if [ $$found = 0 ]; then echo "vtk: no finished runs under $(RUNS)/$(PRESET)/: run 'make runs PRESET=$(PRESET)' first" >&2; exit 1; fi
 
 reference: build

@@ -2,7 +2,8 @@
 
     paths          the one place that defines the pipeline's paths (paper_cases/, runs/, figures/out/, bench/)
     cases          the figure tables figures/figN_<name>.toml (which figure uses which case), case-name parameters
-    constants      the numbers shared with the solver (exit codes, the kinetic/strain warning bound)
+    constants      the numbers shared with the solver, read from `enamel-dem constants --json` (exit codes, warning
+                   bounds, the result seal, result file names)
     paper_values   figures/paper_values.toml: the numbers the paper states, with their sentences
     results        load one result.h5 (Result, Geometry, Frame), interface tags, EXIT_MISSING
     metrics        R-curve comparison and the pooled R_m of Fig. 9

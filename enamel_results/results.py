@@ -7,6 +7,7 @@ fracture energy Gamma_i, rod strength by the interface strength sigma0.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import pathlib
 import struct
@@ -17,6 +18,7 @@ import h5py
 import numpy as np
 
 from enamel_results.cases import params_from_name
+from enamel_results import constants
 from enamel_results.constants import EXIT
 
 
@@ -55,11 +57,33 @@ EXIT_CODES = EXIT   # {name: status}, read from the solver's one definition (ena
 EXIT_MISSING = EXIT_CODES["missing_file"]      # a result file is missing
 EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or fails its checksum
 
-# The seal enamel-dem writes in the result file's HDF5 user block (solver/lib/output.cpp ResultSeal): magic,
-# format, CRC-32 (zlib.crc32) of the whole file with these 4 bytes as zeros, the file's size; little-endian.
-SEAL = struct.Struct("<8sIIQ")
-SEAL_MAGIC = b"ENAMELRS"
-USERBLOCK_BYTES = 512
+
+
+@dataclasses.dataclass(frozen=True)
+class SealLayout:
+    """The seal enamel-dem writes at the start of the result file's HDF5 user block (solver/lib/output.hpp
+    ResultSeal), as the solver declares it (enamel_results.constants.RESULT_SEAL): magic, format, CRC-32
+    (zlib.crc32) of the whole file with the crc field's bytes as zeros, the file's size."""
+    struct: struct.Struct       # the fields in order, little-endian, no padding
+    magic: bytes
+    format: int
+    crc_offset: int             # where the crc field's 4 bytes are
+    userblock_bytes: int
+
+
+@functools.lru_cache(maxsize=None)
+def seal_layout() -> SealLayout:
+    """The solver's seal layout (read from the solver once)."""
+    seal = constants.RESULT_SEAL
+    order = {"little": "<", "big": ">"}[seal["byte_order"]]
+    layout = struct.Struct(order + "".join(f["struct"] for f in seal["fields"]))
+    names = [f["name"] for f in seal["fields"]]
+    offsets = {f["name"]: f["offset"] for f in seal["fields"]}
+    if layout.size != seal["bytes"] or names[0] != "magic" or names[1:] != ["format", "crc", "file_bytes"]:
+        raise ValueError(f"the solver's result seal {seal} is not one this reader knows (magic, format, crc, "
+                         f"file_bytes; {layout.size} bytes)")
+    return SealLayout(layout, seal["magic"].encode("ascii"), seal["format"], offsets["crc"], seal["userblock_bytes"])
+
 
 # Interface tags (/geometry/iface_tag; solver/lib/geometry.hpp InterfaceTag).
 TAG_PLY1, TAG_PLY2, TAG_INTER12, TAG_INTER21 = 0, 1, 2, 3
@@ -84,15 +108,17 @@ class DamagedResult(OSError):
 def verify_result_file(path) -> None:
     """Raise DamagedResult unless `path` carries the solver's seal and its size and CRC-32 match."""
     path = pathlib.Path(path)
+    seal = seal_layout()
     with open(path, "rb") as f:
-        head = f.read(USERBLOCK_BYTES)
-        if len(head) < SEAL.size or head[:len(SEAL_MAGIC)] != SEAL_MAGIC:
+        head = f.read(seal.userblock_bytes)
+        if len(head) < seal.struct.size or head[:len(seal.magic)] != seal.magic:
             raise DamagedResult(path, "it does not begin with the enamel-dem seal")
-        _, fmt, crc, size = SEAL.unpack_from(head)
+        _, fmt, crc, size = seal.struct.unpack_from(head)
         actual = path.stat().st_size
-        if fmt != 1 or size != actual:
+        if fmt != seal.format or size != actual:
             raise DamagedResult(path, f"seal format {fmt}, {size} bytes sealed, {actual} bytes on the disk")
-        ours = zlib.crc32(head[:8 + 4] + b"\0\0\0\0" + head[8 + 4 + 4:])  # magic, format, crc as 0, ...
+        at = seal.crc_offset
+        ours = zlib.crc32(head[:at] + b"\0\0\0\0" + head[at + 4:])  # the block with the crc field as zeros
         while chunk := f.read(1 << 22):
             ours = zlib.crc32(chunk, ours)
     if ours != crc:
@@ -206,19 +232,20 @@ def seal_result_file(path) -> None:
     """Write the seal of a result file again after a deliberate edit (h5py "r+"), as output.cpp writes it: what
     an edit changed is then the file's content, not damage. Only for files that carry a seal."""
     path = pathlib.Path(path)
+    seal = seal_layout()
     with open(path, "r+b") as f:
-        head = f.read(SEAL.size)
-        if head[:len(SEAL_MAGIC)] != SEAL_MAGIC:
+        head = f.read(seal.struct.size)
+        if head[:len(seal.magic)] != seal.magic:
             raise DamagedResult(path, "no enamel-dem seal to renew")
         f.seek(0)
         size = path.stat().st_size
-        f.write(SEAL.pack(SEAL_MAGIC, 1, 0, size))
+        f.write(seal.struct.pack(seal.magic, seal.format, 0, size))
         f.seek(0)
         crc = 0
         while chunk := f.read(1 << 22):
             crc = zlib.crc32(chunk, crc)
         f.seek(0)
-        f.write(SEAL.pack(SEAL_MAGIC, 1, crc, size))
+        f.write(seal.struct.pack(seal.magic, seal.format, crc, size))
 
 
 def load_result(path, case: str | None = None, full: bool = False) -> Result:

@@ -15,7 +15,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 # Lowest first. A file's layer is that of its name (foo.hpp and foo.cpp share one).
 LAYERS = [
-    ("base", ["version", "exit_codes", "errors", "git_hash", "file_io"]),
+    ("base", ["version", "exit_codes", "errors", "git_hash", "file_io", "choices"]),
     ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params"]),
     ("geometry", ["geometry", "far_field"]),
     ("plain data", ["state", "step_timers"]),
@@ -25,7 +25,7 @@ LAYERS = [
                             "integrators/schemes", "integrators/registry", "setup"]),
     ("the simulation", ["simulation", "resources"]),   # resources: estimates from blocks of the case's model
     ("files and tools", ["output", "checkpoint", "profile"]),
-    ("the run", ["runner"]),
+    ("the run", ["runner", "shared_constants"]),
     ("the command line", ["enamel_dem"]),
 ]
 LAYER_OF = {stem: i for i, (_, stems) in enumerate(LAYERS) for stem in stems}

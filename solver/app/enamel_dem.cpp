@@ -21,6 +21,7 @@
 #include "profile.hpp"
 #include "resources.hpp"
 #include "runner.hpp"
+#include "shared_constants.hpp"
 #include "simulation.hpp"
 #include "version.hpp"
 
@@ -81,7 +82,7 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   std::printf("specimen           w_s %g d x h_s %g d, z-period B %.4f d, pre-crack a0 %g d\n", m.w_s, m.h_s, m.B, m.a0);
   std::printf("pre-crack tip      a0_eff %.6g d = (K + 1/4) h_e, K = %d (cut through slice K)", m.a0Eff,
               m.precrackLastSlice);
-  if (m.theta > 0) std::printf(", a crisscross at x = %.6g d (crisscross_at_tip %s)", m.xCrisscross, p.crisscross_at_tip.c_str());
+  if (m.theta > 0) std::printf(", a crisscross at x = %.6g d (crisscross_at_tip %s)", m.xCrisscross, nameOf(p.crisscross_at_tip).c_str());
   std::printf("\n");
   std::printf("slices             %d (h_e %.4f d)\n", m.numSlices, m.h_e);
   std::printf("rods               %d\n", m.numRods());
@@ -161,7 +162,7 @@ int prepareOutput(const std::string& dir, bool force, std::string& resultPath) {
 // file of a run that completed with these inputs, so it goes now, not when this run ends.
 void removeStaleResults(const std::string& dir) {
   std::error_code ec;
-  for (const char* status : {"completed", "failed"}) fs::remove(resultFileFor(dir, status), ec);
+  for (RunStatus status : {RunStatus::completed, RunStatus::failed}) fs::remove(resultFileFor(dir, status), ec);
 }
 
 struct RunFlags {
@@ -222,16 +223,16 @@ int runRun(const CaseArgs& args, RunFlags flags) {
     for (double J : rec.rcurveJ) R.push_back(J / p.Gamma());
     return summariseRcurve(rec.rcurveDa, R);
   }();
-  std::fprintf(stderr, "enamel-dem: %s: %s after %ld steps, %.1f s: %s\n", p.sourceName.c_str(), rec.status.c_str(),
+  std::fprintf(stderr, "enamel-dem: %s: %s after %ld steps, %.1f s: %s\n", p.sourceName.c_str(), nameOf(rec.status).c_str(),
                rec.steps, rec.wallSeconds, rec.stopReason.c_str());
   std::fprintf(stderr, "enamel-dem: R_init/Gamma %.4g  R_ss/Gamma %.4g  da_max/d %.3g  broken rods %d  energy balance %.3g\n",
                s.R_init, s.R_ss, s.daMax, sim.state.brokenBeams(),
                rec.history.empty() ? 0.0 : rec.history.back().balanceError);
   for (const auto& w : rec.warnings) std::fprintf(stderr, "enamel-dem: warning: %s\n", w.c_str());
-  if (rec.status == "failed")
+  if (rec.status == RunStatus::failed)
     return fail(exit_code::run_unstable,
                 rec.stopReason + " (partial result kept in " + resultFileFor(outDir, rec.status) + ")");
-  if (rec.status == "interrupted") {
+  if (rec.status == RunStatus::interrupted) {
     std::fprintf(stderr, "enamel-dem: partial result in %s; continue with --resume (or --restart)\n",
                  resultFileFor(outDir, rec.status).c_str());
     return exit_code::interrupted;
@@ -292,6 +293,11 @@ int main(int argc, char** argv) {
   profile->add_option("--steps", profileSteps, "steps timed")->check(CLI::PositiveNumber);
 
   CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
+  bool constantsJson = false;
+  CLI::App* constants = app.add_subcommand(
+      "constants", "print the numbers the Python side shares with the solver: exit statuses, warning bounds, the "
+                   "result file's seal and names, the adaptive loading rate's bounds, the case keys' choices (TOML)");
+  constants->add_flag("--json", constantsJson, "print them as one JSON object (what enamel_results/constants.py reads)");
 
   try {
     app.parse(argc, argv);
@@ -308,6 +314,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*keys) { std::cout << formatKeysMarkdown(); return exit_code::ok; }
+    if (*constants) { std::cout << (constantsJson ? sharedConstantsJson() : sharedConstantsToml()); return exit_code::ok; }
     if (*info) return runInfo(infoArgs, estimateOnly);
     if (*run) return runRun(runArgs, flags);
     if (*profile) return runProfile(profileArgs, profileWarmup, profileSteps);

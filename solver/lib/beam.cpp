@@ -197,13 +197,6 @@ double maxTensileStress(const Section& s, const Vec12& fLocal) {
   return maxTensileStressOfRows(s, f);
 }
 
-RodStress parseRodStress(const std::string& name) {
-  if (name == "axial_bending") return RodStress::AxialBending;
-  if (name == "axial") return RodStress::Axial;
-  if (name == "principal") return RodStress::Principal;
-  throw std::invalid_argument("rod_stress '" + name + "' is not one of axial_bending, axial, principal");
-}
-
 // sigma = N/A, N = f_local[6] (tension positive)
 double axialStressOfRows(const Section& s, const Vec5& f) { return f[2] / s.A; }
 
@@ -216,9 +209,9 @@ double principalStressOfRows(const Section& s, const Vec5& f, double torque) {
 
 double rodStressOfRows(RodStress kind, const Section& s, const Vec5& f, double torque) {
   switch (kind) {
-    case RodStress::Axial: return axialStressOfRows(s, f);
-    case RodStress::Principal: return principalStressOfRows(s, f, torque);
-    case RodStress::AxialBending: break;
+    case RodStress::axial: return axialStressOfRows(s, f);
+    case RodStress::principal: return principalStressOfRows(s, f, torque);
+    case RodStress::axial_bending: break;
   }
   return maxTensileStressOfRows(s, f);
 }

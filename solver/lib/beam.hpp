@@ -15,6 +15,8 @@
 
 #include <string>
 
+#include "choices.hpp"
+
 namespace enamel::beam {
 
 using Vec3 = Eigen::Vector3d;
@@ -87,10 +89,8 @@ double stressChangeBound(const Section& s, const StressOperator& S);
 
 // Alternative rod stress definitions (case key rod_stress), for the paper's undefined "maximum rod stress
 // sigma_r,max"; the default axial_bending is maxTensileStressOfRows above. All are tension positive and
-// scale linearly with the displacements (positively homogeneous), as the static start's U_c needs.
-enum class RodStress { AxialBending, Axial, Principal };
-// "axial_bending" | "axial" | "principal"; throws std::invalid_argument naming the allowed values otherwise.
-RodStress parseRodStress(const std::string& name);
+// scale linearly with the displacements (positively homogeneous), as the static start's U_c needs. The kinds are
+// the case key's enum RodStress (choices.hpp).
 
 // axial: sigma = N/A (N = f[2] = f_local[6], the same at both ends); needs only the kStressRows rows.
 double axialStressOfRows(const Section& s, const Vec5& f);

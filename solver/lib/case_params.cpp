@@ -15,6 +15,8 @@
 #include <iterator>
 #include <limits>
 #include <sstream>
+#include <type_traits>
+#include <utility>
 #include <variant>
 
 namespace enamel {
@@ -33,9 +35,42 @@ constexpr bool isOpenEnd(const char* bounds, int end) {
                  : throw std::logic_error("case_params: bounds must be one of \"[]\" \"[)\" \"(]\" \"()\"");
 }
 
-#define ENAMEL_CASE_KEY_SPEC(name, kind, group, need, default_, bounds, min, max, choices, unit, doc)       \
+// The names of a Choice key's enum, "" for any other kind; a Choice key whose field is not an enum, or an enum
+// field of another kind, does not compile.
+template <class Field>
+constexpr const char* choicesOf(Kind kind) {
+    if constexpr (std::is_enum_v<Field>)
+        return kind == Kind::Choice ? enumNamesText(Field{})
+                                    : throw std::logic_error("case_params: an enum field is a Choice key");
+    else
+        return kind != Kind::Choice ? "" : throw std::logic_error("case_params: a Choice key's field is an enum");
+}
+
+// A Choice key's field as the index of its enumerator, and back.
+template <auto Member>
+std::size_t getChoice(const CaseParams& p) {
+    return static_cast<std::size_t>(p.*Member);
+}
+template <auto Member>
+void setChoice(CaseParams& p, std::size_t index) {
+    using Enum = std::remove_reference_t<decltype(p.*Member)>;
+    p.*Member = static_cast<Enum>(index);
+}
+
+// The KeyField of a member: the member itself, or a ChoiceField for an enum.
+template <auto Member>
+constexpr KeyField keyFieldOf() {
+    using Field = std::remove_reference_t<decltype(std::declval<CaseParams&>().*Member)>;
+    if constexpr (std::is_enum_v<Field>)
+        return ChoiceField{&getChoice<Member>, &setChoice<Member>};
+    else
+        return Member;
+}
+
+#define ENAMEL_CASE_KEY_SPEC(name, kind, group, need, default_, bounds, min, max, unit, doc)                   \
     KeySpec{#name, Kind::kind, #group, Need::need == Need::required, min, max, isOpenEnd(bounds, 0),       \
-            isOpenEnd(bounds, 1), choices, unit, doc, &CaseParams::name},
+            isOpenEnd(bounds, 1), choicesOf<decltype(CaseParams::name)>(Kind::kind), unit, doc,            \
+            keyFieldOf<&CaseParams::name>()},
 constexpr KeySpec kCaseKeys[] = {ENAMEL_CASE_KEYS(ENAMEL_CASE_KEY_SPEC)};
 #undef ENAMEL_CASE_KEY_SPEC
 
@@ -188,18 +223,6 @@ std::string renderNode(const toml::node& v) {
     return os.str();
 }
 
-std::vector<std::string> splitChoices(const char* choices) {
-    std::vector<std::string> out;
-    std::string s = choices;
-    std::size_t start = 0;
-    while (start <= s.size()) {
-        const std::size_t bar = std::min(s.find('|', start), s.size());
-        out.push_back(s.substr(start, bar - start));
-        start = bar + 1;
-    }
-    return out;
-}
-
 std::string formatBound(const KeySpec& s, double x) {
     return s.kind == Kind::Integer ? formatInteger(x) : formatNumber(x);
 }
@@ -219,7 +242,7 @@ std::string formatAllowed(const KeySpec& s) {
         case Kind::Text: return "any string";
         case Kind::Choice: {
             std::string out = "one of ";
-            const auto c = splitChoices(s.choices);
+            const auto c = splitEnumNames(s.choices);
             for (std::size_t i = 0; i < c.size(); ++i) out += (i ? ", " : "") + quote(c[i]);
             return out;
         }
@@ -250,7 +273,7 @@ std::string formatValue(const CaseParams& p, const KeySpec& s, std::string (*for
         case Kind::Real: return formatReal(fieldOf<Kind::Real>(p, s));
         case Kind::Integer: return std::to_string(fieldOf<Kind::Integer>(p, s));
         case Kind::Bool: return fieldOf<Kind::Bool>(p, s) ? "true" : "false";
-        case Kind::Choice: return quote(fieldOf<Kind::Choice>(p, s));
+        case Kind::Choice: return quote(splitEnumNames(s.choices).at(std::get<ChoiceField>(s.field).get(p)));
         case Kind::Text: return quote(fieldOf<Kind::Text>(p, s));
         case Kind::RealList: {
             std::string out = "[";
@@ -386,9 +409,10 @@ void applyKey(CaseParams& p, const KeySpec& s, const toml::node& v, const std::s
         case Kind::Choice: {
             auto str = v.as_string();
             if (!str) throwWrongType(src, s, v);
-            const auto c = splitChoices(s.choices);
-            if (std::find(c.begin(), c.end(), str->get()) == c.end()) throwOutOfRange(src, s, v, "is not a valid choice");
-            fieldOf<Kind::Choice>(p, s) = str->get();
+            const auto c = splitEnumNames(s.choices);
+            const auto it = std::find(c.begin(), c.end(), str->get());
+            if (it == c.end()) throwOutOfRange(src, s, v, "is not a valid choice");
+            std::get<ChoiceField>(s.field).set(p, static_cast<std::size_t>(it - c.begin()));
             break;
         }
         case Kind::Text: {

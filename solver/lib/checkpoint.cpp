@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -46,6 +47,10 @@ struct Writer {
   }
   void vec(const VecX& v) { vec(std::vector<double>(v.data(), v.data() + v.size())); }
   void str(const std::string& s) { vec(std::vector<char>(s.begin(), s.end())); }
+  template <class E>
+  void named(const E& e) {  // a named enum (choices.hpp), by its name
+    str(nameOf(e));
+  }
   template <class T, class F>
   void items(const std::vector<T>& v, F each) {  // a count, then each item
     pod(static_cast<std::uint64_t>(v.size()));
@@ -84,6 +89,14 @@ struct Reader {
     vec(tmp);
     s.assign(tmp.begin(), tmp.end());
   }
+  template <class E>
+  void named(E& e) {
+    std::string name;
+    str(name);
+    const std::optional<E> value = enumFromName<E>(name);
+    if (!value) throw CheckpointDamaged(damaged(path, "no such value '" + name + "'"));
+    e = *value;
+  }
   template <class T, class F>
   void items(std::vector<T>& v, F each) {
     std::uint64_t n = 0;
@@ -111,7 +124,7 @@ void transferFields(Io& io, S& s, R& rec) {
     io.vec(f.nodeDisplacement); io.vec(f.ifaceDamage); io.vec(f.ifaceState); io.vec(f.beamBroken);
     io.vec(f.beamStress);
   });
-  io.str(rec.status); io.str(rec.stopReason);
+  io.named(rec.status); io.str(rec.stopReason);
   io.pod(rec.wallSeconds); io.pod(rec.steps); io.pod(rec.maxKineticRatio);
   io.pod(rec.warnedBalance); io.pod(rec.warnedKinetic); io.pod(rec.warnedEdge); io.pod(rec.warnedFarFieldRod);
   io.items(rec.warnings, [&](auto& w) { io.str(w); });

@@ -62,12 +62,14 @@ class Integrator {
 /// A scheme's factory: the scheme set up for these operators.
 using IntegratorFactory = std::unique_ptr<Integrator> (*)(const CaseParams& p, const Model& m, const Materials& mat,
                                                           const Operators& ops);
-/// A row of the table of schemes: the `integrator` key's value that chooses it, and its factory.
+/// A row of the table of schemes: the `integrator` key's value that chooses it (its name: nameOf(scheme)), and its
+/// factory.
 struct IntegratorEntry {
-  const char* name;
+  IntegratorScheme scheme;
   IntegratorFactory make;
 };
-/// Every scheme of this build, in the order of the `integrator` key's choices (integrators/registry.cpp).
+/// Every scheme of this build, one row per enumerator of IntegratorScheme in its order (integrators/registry.cpp;
+/// tests/cpp/test_integrators.cpp checks that they agree).
 const std::vector<IntegratorEntry>& integratorRegistry();
 
 /// The integrator named by p.integrator (its row of integratorRegistry()), set up for these operators. Throws

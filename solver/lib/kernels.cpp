@@ -273,26 +273,26 @@ namespace {
   return beam::maxTensileStressOfRows(mat.section, fl);
 }
 
-// The alternative definitions of case key rod_stress (beam.hpp RodStress); axial_bending is stressOfBeam above.
+// The alternative definitions of case key rod_stress (choices.hpp RodStress); axial_bending is stressOfBeam above.
 // principal reads one more row of K_local T, the torque.
 double stressOfBeamAlternative(const Model& m, const Materials& mat, const VecX& q, int e) {
   const int c = m.beamClass(e);
   const beam::Vec12 ue = gatherElement(q, m.beamNodes[e][0], m.beamNodes[e][1]);
   const beam::Vec5 fl = mat.beamStressOperator[c].lazyProduct(ue);
-  const double torque = mat.rodStress == beam::RodStress::Principal ? mat.beamTorsionOperator[c].dot(ue) : 0.0;
+  const double torque = mat.rodStress == RodStress::principal ? mat.beamTorsionOperator[c].dot(ue) : 0.0;
   return beam::rodStressOfRows(mat.rodStress, mat.section, fl, torque);
 }
 }  // namespace
 
 double computeStressOfBeam(const Model& m, const Materials& mat, const VecX& q, int e) {
-  if (mat.rodStress != beam::RodStress::AxialBending) return stressOfBeamAlternative(m, mat, q, e);
+  if (mat.rodStress != RodStress::axial_bending) return stressOfBeamAlternative(m, mat, q, e);
   return stressOfBeam(m, mat, q, e);
 }
 
 void computeStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                  const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio) {
   ratio.resize(m.numBeams());
-  if (mat.rodStress != beam::RodStress::AxialBending) {  // rod_stress alternatives: off the default's loop
+  if (mat.rodStress != RodStress::axial_bending) {  // rod_stress alternatives: off the default's loop
 #pragma omp parallel for schedule(static)
     for (int e = 0; e < m.numBeams(); ++e)
       ratio[e] = beamBroken[e] ? 0.0 : stressOfBeamAlternative(m, mat, q, e) / mat.beamStrength[e];
@@ -308,7 +308,7 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
                                const std::vector<std::uint8_t>& beamBroken, long step, double moved,
                                StressCheckSchedule& schedule, std::vector<double>& ratio) {
   const int ne = m.numBeams();
-  if (mat.rodStress != beam::RodStress::AxialBending || !std::isfinite(moved)) {  // no bound: compute them all
+  if (mat.rodStress != RodStress::axial_bending || !std::isfinite(moved)) {  // no bound: compute them all
     computeStressRatiosForBeams(m, mat, q, beamBroken, ratio);
     schedule.step = -1;
     schedule.computed = ne;

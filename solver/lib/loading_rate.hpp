@@ -18,7 +18,7 @@
 
 namespace enamel {
 
-// The rule's bounds (the quasi-static warning bound, runner.cpp kKineticWarn, is 0.05).
+// The rule's bounds (the quasi-static warning bound, runner.hpp kKineticWarn, is 0.05).
 constexpr double kRateRhoHigh = 0.01;     // rho = kinetic / strain above this: halve phi
 constexpr double kRateRhoLow = 0.0025;    // rho below this (and nothing broke): raise phi
 constexpr double kRateRaise = 1.25;       // raise: phi x 1.25 (not above rate_adapt_max)

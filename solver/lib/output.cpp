@@ -4,10 +4,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <functional>
+#include <iterator>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
@@ -45,9 +47,42 @@ Frame captureFrame(const Simulation& sim, double targetDa) {
   return f;
 }
 
-std::string resultFileFor(const std::string& dir, const std::string& status) {
-  const char* name = status == "completed" ? "result.h5" : status == "failed" ? "result.failed.h5" : "result.partial.h5";
-  return dir + "/" + name;
+const char* resultFileName(RunStatus status) {
+  switch (status) {
+    case RunStatus::completed: return "result.h5";
+    case RunStatus::failed: return "result.failed.h5";
+    case RunStatus::running:
+    case RunStatus::interrupted: break;
+  }
+  return "result.partial.h5";
+}
+
+std::string resultFileFor(const std::string& dir, RunStatus status) { return dir + "/" + resultFileName(status); }
+
+namespace {
+constexpr SealField kSealFields[] = {
+    {"magic", "8s", offsetof(ResultSeal, magic), sizeof(ResultSeal::magic)},
+    {"format", "I", offsetof(ResultSeal, format), sizeof(ResultSeal::format)},
+    {"crc", "I", offsetof(ResultSeal, crc), sizeof(ResultSeal::crc)},
+    {"file_bytes", "Q", offsetof(ResultSeal, fileBytes), sizeof(ResultSeal::fileBytes)},
+};
+// The fields tile the struct without gaps, in order, and their codes have their sizes (Python's struct, "<").
+constexpr bool sealFieldsTileTheStruct() {
+  std::size_t at = 0;
+  for (const SealField& f : kSealFields) {
+    const std::size_t codeBytes = f.structCode[0] == 'I' ? 4 : f.structCode[0] == 'Q' ? 8 : f.structCode[0] - '0';
+    if (f.offset != at || f.bytes != codeBytes) return false;
+    at += f.bytes;
+  }
+  return at == sizeof(ResultSeal);
+}
+static_assert(sealFieldsTileTheStruct(), "sealFields must list ResultSeal's fields in order with their sizes");
+static_assert(sizeof(ResultSeal) == 24 && sizeof(ResultSeal) <= kUserblockBytes, "the seal fits the user block");
+}  // namespace
+
+const std::vector<SealField>& sealFields() {
+  static const std::vector<SealField> fields(std::begin(kSealFields), std::end(kSealFields));
+  return fields;
 }
 
 const std::vector<HistoryColumn>& historyColumns() {
@@ -119,17 +154,6 @@ namespace {
 
 // Peak resident memory of this process (VmHWM of /proc/self/status) in MB; NaN where there is no /proc.
 double peakMemoryMB() { return readProcKilobytes("/proc/self/status", "VmHWM") / 1024.0; }
-
-// The result file's seal in HDF5's user block (see sealImage).
-constexpr hsize_t kUserblockBytes = 512;
-constexpr char kResultMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'R', 'S'};
-struct ResultSeal {
-  char magic[8];
-  std::uint32_t format = 1;  // of this block
-  std::uint32_t crc = 0;     // CRC-32 of the whole file, these 4 bytes as zeros
-  std::uint64_t fileBytes = 0;
-};
-static_assert(sizeof(ResultSeal) == 24, "the seal's layout is read by enamel_results/results.py");
 
 // --- a thin RAII layer over the HDF5 C API ---
 struct Handle {
@@ -226,12 +250,12 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "integrator", sim.integrator->name());
   attr(g.id, "integrator_details", sim.integrator->describe());
   attr(g.id, "added_rotary_inertia", sim.integrator->addedRotaryInertia());
-  attr(g.id, "linear_solver", p.linear_solver);
-  attr(g.id, "deletion_rule", p.deletion_rule);
-  attr(g.id, "rod_stress", p.rod_stress);
+  attr(g.id, "linear_solver", nameOf(p.linear_solver));
+  attr(g.id, "deletion_rule", nameOf(p.deletion_rule));
+  attr(g.id, "rod_stress", nameOf(p.rod_stress));
   attr(g.id, "seed", static_cast<long>(p.seed));
   attr(g.id, "strength_generator", kStrengthGenerator);
-  attr(g.id, "status", rec.status);
+  attr(g.id, "status", nameOf(rec.status));
   attr(g.id, "stop_reason", rec.stopReason);
   std::string warnings;
   for (const auto& w : rec.warnings) warnings += w + "\n";
@@ -258,9 +282,9 @@ void writeMeta(hid_t file, const Simulation& sim, const RunRecord& rec) {
   attr(g.id, "k", p.k());
   attr(g.id, "softening_over_delta0", p.softening_over_delta0);
   attr(g.id, "shear_strength_ratio", p.shear_strength_ratio);
-  attr(g.id, "grip_constraint", p.grip_constraint);
-  attr(g.id, "grip_profile", p.grip_profile);
-  attr(g.id, "crisscross_at_tip", p.crisscross_at_tip);
+  attr(g.id, "grip_constraint", nameOf(p.grip_constraint));
+  attr(g.id, "grip_profile", nameOf(p.grip_profile));
+  attr(g.id, "crisscross_at_tip", nameOf(p.crisscross_at_tip));
   attr(g.id, "a0_effective", sim.model.a0Eff);  // the pre-crack tip (K + 1/4) h_e that Delta_a is measured from
   attr(g.id, "sigma_ru_mean", p.sigma_ru());
   const StaticStart& st = rec.staticStart;

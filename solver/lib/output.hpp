@@ -4,14 +4,19 @@
 // over `path` (file_io.hpp), so a reader (or a run killed half-way) never sees a half-written file and a full
 // disk leaves the previous file. HDF5's 512-byte user block holds a seal: the file's size and a CRC-32 of all
 // its bytes, which enamel_results checks before it reads the file.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "choices.hpp"
 #include "simulation.hpp"
 
 namespace enamel {
+
+/// Where a run stands; its name (nameOf) is what /meta status, the checkpoint and the messages say.
+ENAMEL_NAMED_ENUM(RunStatus, running, completed, failed, interrupted)
 
 /// A snapshot of the damage state for the process-zone maps (Figs. 4-6, 8).
 struct Frame {
@@ -30,7 +35,7 @@ struct RunRecord {
   std::vector<Measurement> history;
   std::vector<double> rcurveDa, rcurveJ;  // one point each time the crack advanced
   std::vector<Frame> frames;
-  std::string status = "running";         // running | completed | failed | interrupted
+  RunStatus status = RunStatus::running;
   std::string stopReason;                 // which criterion stopped it, or what went wrong
   double wallSeconds = 0;
   long steps = 0;
@@ -63,10 +68,34 @@ struct RcurveSummary {
 };
 RcurveSummary summariseRcurve(const std::vector<double>& da, const std::vector<double>& RoverGamma);
 
-/// The result file of a run directory for a run of this status. `result.h5` exists only for a completed run
-/// (so a pipeline that counts it as done is never fooled); a run in progress or interrupted writes
-/// `result.partial.h5`, a failed one leaves `result.failed.h5`.
-std::string resultFileFor(const std::string& dir, const std::string& status);
+/// The name of the result file of a run of this status. `result.h5` exists only for a completed run (so a
+/// pipeline that counts it as done is never fooled); a run in progress or interrupted writes `result.partial.h5`,
+/// a failed one leaves `result.failed.h5`.
+const char* resultFileName(RunStatus status);
+/// The result file of a run directory for a run of this status: dir/resultFileName(status).
+std::string resultFileFor(const std::string& dir, RunStatus status);
+
+/// The seal of a result file, at the start of HDF5's user block of kUserblockBytes: kResultMagic, the format of
+/// this block (kSealFormat), the CRC-32 (file_io.hpp crc32) of the whole file with the crc field's 4 bytes read as
+/// zeros, and the file's size in bytes; little-endian (x86-64), no padding. enamel_results/results.py reads the
+/// layout from `enamel-dem constants` (sealFields).
+inline constexpr std::size_t kUserblockBytes = 512;
+inline constexpr char kResultMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'R', 'S'};
+inline constexpr std::uint32_t kSealFormat = 1;
+struct ResultSeal {
+  char magic[8];
+  std::uint32_t format = kSealFormat;
+  std::uint32_t crc = 0;
+  std::uint64_t fileBytes = 0;
+};
+/// One field of ResultSeal: its name, Python struct code and byte offset.
+struct SealField {
+  const char* name;
+  const char* structCode;
+  std::size_t offset, bytes;
+};
+/// The fields of ResultSeal in order (output.cpp checks them against the struct at compile time).
+const std::vector<SealField>& sealFields();
 
 /// Write the whole result file atomically. Throws WriteError (file_io.hpp) naming the file and its size when it
 /// cannot be written (diskFull: no space or quota), std::runtime_error for an HDF5 error.

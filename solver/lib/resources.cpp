@@ -36,7 +36,7 @@ ResourceEstimate estimateResources(const CaseParams& p) {
   e.nodes = e.slices * perSlice;
   e.dof = 6 * e.nodes;
   e.interfaces = 3 * e.nodes;
-  e.memoryBytes = kBaseBytes + (p.integrator == "paper"
+  e.memoryBytes = kBaseBytes + (p.integrator == IntegratorScheme::paper
                                     ? e.nodes * (kPaperBytesPerNode + kPaperFillBytesPerNodeSliceNode * perSlice)
                                     : e.nodes * kLumpedBytesPerNode);
   if (p.static_start > 0) e.memoryBytes += e.nodes * (kStaticBytesPerNode + kStaticFillBytesPerNodeSliceNode * perSlice);
@@ -96,7 +96,7 @@ double startDisplacement(const CaseParams& p) {
 // One core's seconds per step: `lumped` a DOF-update rate; `paper` also the Cholesky solve, whose cost per DOF
 // grows with the nodes of a slice (the factor's bandwidth).
 double secondsPerStep(const CaseParams& p, const ResourceEstimate& e) {
-  if (p.integrator == "paper") return e.dof * (kPaperSecondsPerDof + kPaperSecondsPerDofSliceNode * e.nodes / e.slices);
+  if (p.integrator == IntegratorScheme::paper) return e.dof * (kPaperSecondsPerDof + kPaperSecondsPerDofSliceNode * e.nodes / e.slices);
   return e.dof / kLumpedDofUpdatesPerSecond;
 }
 
@@ -171,7 +171,7 @@ std::string checkMemoryFits(const CaseParams& p, double available) {
                 "the case needs about %.3g GB of memory (%.3g nodes, %.3g DOF, %.3g interfaces: w_s_over_d = %g, "
                 "h_s_over_d = %g, h_e_over_d = %g, integrator %s) and %.3g GB are available",
                 e.memoryBytes / 1e9, e.nodes, e.dof, e.interfaces, p.w_s_over_d, p.h_s_over_d, p.h_e_over_d,
-                p.integrator.c_str(), available / 1e9);
+                nameOf(p.integrator).c_str(), available / 1e9);
   return buf;
 }
 

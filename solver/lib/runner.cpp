@@ -23,10 +23,7 @@ namespace enamel {
 namespace {
 volatile std::sig_atomic_t gStopSignal = 0;
 
-// Quasi-static and stability bounds (docs/solver.md, Time integration and checks). Warnings are recorded in /meta/warnings;
-// the failure bound stops the run.
-constexpr double kBalanceWarn = 0.02;      // |energy balance error| above this: warning
-constexpr double kKineticWarn = 0.05;      // kinetic / strain energy above this: not quasi-static, warning
+// The warning bounds kBalanceWarn and kKineticWarn: runner.hpp.
 constexpr double kEdgeWarnDistance = 2.0;  // d: the inelastic zone this near the loaded edges: warning
 
 std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0, double e = 0) {
@@ -222,7 +219,7 @@ class RunLoop {
         frameTargets_(p_.frames_da_over_d),
         stopTargets_{p_.stop_da_over_d, p_.stop_u_over_d, double(p_.max_steps)},
         guard_(guardBounds(p_.Gamma(), sim.model.B)), burstInterfaces_(burstInterfacesOf(sim.model)),
-        partialPath_(resultFileFor(opt.outDir, "running")) {
+        partialPath_(resultFileFor(opt.outDir, RunStatus::running)) {
     const double dt = sim.integrator->timeStep();
     historyEvery_ = p_.history_every > 0
         ? p_.history_every : std::max(1L, std::lround(0.05 * sim.model.h_s / sim.materials.c_d / dt));
@@ -233,7 +230,7 @@ class RunLoop {
   void start() {
     if (opt_.restart) {
       readCheckpoint(opt_.checkpointPath, sim_, rec_);
-      rec_.status = "running";
+      rec_.status = RunStatus::running;
       rec_.stopReason.clear();
       wallBefore_ = lastCheckpoint_ = rec_.wallSeconds;
       lastDa_ = rec_.rcurveDa.empty() ? 0.0 : rec_.rcurveDa.back();
@@ -332,7 +329,7 @@ class RunLoop {
     const Model& m = sim_.model;
     const double bandEdge = m.fullHalfHeight - kEdgeWarnDistance;
     if (m.hasFarField() && r.inelasticReach > bandEdge) {
-      const bool rodBreaksAllowed = p_.far_field_rod_breaks == "allow";
+      const bool rodBreaksAllowed = p_.far_field_rod_breaks == FarFieldRodBreaks::allow;
       const double interfaceReach = rodBreaksAllowed ? sim_.inelasticInterfaceReach() : r.inelasticReach;
       if (interfaceReach > bandEdge || !rodBreaksAllowed)
         return fail(fmt(rodBreaksAllowed ? "interfaces past delta0 reached %.3g d from the crack plane at step %.0f "
@@ -439,7 +436,7 @@ class RunLoop {
     else if (gStopSignal)
       rec_.stopReason = fmt("interrupted by signal %.0f", gStopSignal);
     if (rec_.stopReason.empty()) return false;
-    rec_.status = gStopSignal ? "interrupted" : "completed";
+    rec_.status = gStopSignal ? RunStatus::interrupted : RunStatus::completed;
     if (gStopSignal) checkpoint();  // the state after this step: a restart continues from here
     return true;
   }
@@ -453,16 +450,16 @@ class RunLoop {
   /// and the checkpoint removed when the run completed.
   RunRecord finish() {
     if (opt_.progress && tty_) std::fprintf(stderr, "\n");
-    if (rec_.status != "failed" || rec_.history.empty() || rec_.history.back().step != sim_.state.step)
+    if (rec_.status != RunStatus::failed || rec_.history.empty() || rec_.history.back().step != sim_.state.step)
       rec_.history.push_back(sim_.measure());
-    if (rec_.status == "completed") {  // the steps since the last checked row: a run blown up there is no result
+    if (rec_.status == RunStatus::completed) {  // the steps since the last checked row: a run blown up there is no result
       const std::string blowUp = blowUpCheck(rec_.history.back(), kineticRatioOf(rec_.history.back()), guard_);
       if (!blowUp.empty()) fail(blowUp);
     }
     rec_.frames.push_back(captureFrame(sim_, -1.0));
     save();
     if (resultFileFor(opt_.outDir, rec_.status) != partialPath_) std::remove(partialPath_.c_str());
-    if (rec_.status == "completed" && !opt_.checkpointPath.empty()) std::remove(opt_.checkpointPath.c_str());
+    if (rec_.status == RunStatus::completed && !opt_.checkpointPath.empty()) std::remove(opt_.checkpointPath.c_str());
     return rec_;
   }
 
@@ -488,7 +485,7 @@ class RunLoop {
     lastCheckpoint_ = rec_.wallSeconds;
   }
   bool fail(const std::string& why) {
-    rec_.status = "failed";
+    rec_.status = RunStatus::failed;
     rec_.stopReason = why;
     return false;
   }

@@ -11,6 +11,11 @@
 
 namespace enamel {
 
+// Quasi-static and stability warnings (docs/solver.md, Time integration and checks), recorded in /meta/warnings;
+// the failure bounds that stop a run are GuardBounds below. Python reads them from `enamel-dem constants`.
+inline constexpr double kBalanceWarn = 0.02;  // |energy balance error| above this at any history row: warning
+inline constexpr double kKineticWarn = 0.05;  // quasiStaticRatio above this: not quasi-static, warning
+
 struct RunOptions {
   std::string outDir;                // the run directory: result files (resultFileFor) go there
   bool progress = true;              // progress lines on stderr

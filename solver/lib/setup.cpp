@@ -25,12 +25,12 @@ GeometryParams geometryOf(const CaseParams& p) {
   g.a0 = p.a0();
   g.h_e = p.h_e_over_d;
   g.crisscross_phase = p.crisscross_phase;
-  g.crisscrossCutAtTip = p.crisscross_at_tip == "cut";
+  g.crisscrossCutAtTip = p.crisscross_at_tip == CrisscrossAtTip::cut;
   return g;
 }
 
 beam::Section sectionOf(const CaseParams& p) {
-  return p.section == "circle" ? beam::circularSection(1.0, 1.0, p.nu_r, 1.0)
+  return p.section == SectionShape::circle ? beam::circularSection(1.0, 1.0, p.nu_r, 1.0)
                                : beam::hexagonalSection(1.0, 1.0, p.nu_r, 1.0);
 }
 
@@ -41,10 +41,8 @@ cohesive::Law lawOf(const CaseParams& p) {
 
 Grips gripsOf(const CaseParams& p) {
   Grips g;
-  if (p.grip_profile == "about_centre") g.profile = Grips::Profile::aboutCentre;
-  else if (p.grip_profile != "to_right_edge") throw std::logic_error("grip_profile '" + p.grip_profile + "'");
-  if (p.grip_constraint == "uxuy") g.holdUx = true;
-  else if (p.grip_constraint != "uy") throw std::logic_error("grip_constraint '" + p.grip_constraint + "'");
+  if (p.grip_profile == GripProfile::about_centre) g.profile = Grips::Profile::aboutCentre;
+  g.holdUx = p.grip_constraint == GripConstraint::uxuy;
   return g;
 }
 
@@ -71,7 +69,7 @@ void describeMaterials(const CaseParams& p, Materials& mat) {
   mat.law = lawOf(p);
   mat.rodsBreakable = p.rods_breakable;
   mat.deletionRule = p.deletion_rule;
-  mat.rodStress = beam::parseRodStress(p.rod_stress);
+  mat.rodStress = p.rod_stress;
   mat.grips = gripsOf(p);
 }
 

@@ -121,9 +121,9 @@ namespace {
 //  "all":             every element with ratio >= 1.
 // `worst` is the largest ratio (StressCheckSchedule::largestRatio: the deletion check's, exact whenever it is >= 1).
 std::vector<int> findOverloadedBeams(const std::vector<double>& ratio, const std::vector<std::uint8_t>& beamBroken,
-                                     const std::string& rule, double worst) {
+                                     DeletionRule rule, double worst) {
   if (!(worst >= 1.0)) return {};
-  const double threshold = rule == "all" ? 1.0 : worst * (1.0 - 1e-9);
+  const double threshold = rule == DeletionRule::all ? 1.0 : worst * (1.0 - 1e-9);
   std::vector<int> overloaded;
   for (std::size_t e = 0; e < ratio.size(); ++e)
     if (!beamBroken[e] && ratio[e] >= threshold) overloaded.push_back(static_cast<int>(e));

@@ -61,8 +61,8 @@ struct Materials {
   cohesive::Law law;
   std::vector<double> beamStrength;  // sigma_ru per rod element
   bool rodsBreakable = true;
-  std::string deletionRule;          // case key deletion_rule
-  beam::RodStress rodStress = beam::RodStress::AxialBending;  // case key rod_stress
+  DeletionRule deletionRule = DeletionRule::most_overloaded;  // case key deletion_rule
+  RodStress rodStress = RodStress::axial_bending;  // case key rod_stress
   // per element class Model::beamClass (ply: all rods of a ply share one orientation; and span): K_local T
   // (u_e -> local end forces), and the global element stiffness, consistent mass and lumped mass
   std::vector<beam::Mat12> beamLocalForceOperator, beamK, beamMc, beamMl;

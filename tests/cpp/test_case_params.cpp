@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <set>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #ifndef ENAMEL_SOURCE_DIR
@@ -22,6 +24,7 @@ using enamel::CaseParams;
 using enamel::KeySpec;
 using enamel::Kind;
 using enamel::parseCase;
+using namespace enamel;  // the choices' enums (choices.hpp)
 namespace exit_code = enamel::exit_code;
 
 namespace {
@@ -82,16 +85,16 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.sigma_ru_over_sigma0, 21.4);
     EXPECT_EQ(p.cv, 0.0);
     EXPECT_EQ(p.Gamma_k_over_sigma0sq, 10.0);
-    EXPECT_EQ(p.section, "hexagon");
+    EXPECT_EQ(p.section, SectionShape::hexagon);
     EXPECT_EQ(p.seed, 1);
     EXPECT_TRUE(p.rods_breakable);
     EXPECT_TRUE(p.interfaces_breakable);
     EXPECT_EQ(p.w_s_over_d, 32.0);
     EXPECT_EQ(p.h_s_over_d, 16.0);
     EXPECT_EQ(p.h_e_over_d, 0.3);
-    EXPECT_EQ(p.integrator, "paper");
-    EXPECT_EQ(p.linear_solver, "cholmod");
-    EXPECT_EQ(p.deletion_rule, "most_overloaded");
+    EXPECT_EQ(p.integrator, IntegratorScheme::paper);
+    EXPECT_EQ(p.linear_solver, LinearSolver::cholmod);
+    EXPECT_EQ(p.deletion_rule, DeletionRule::most_overloaded);
     EXPECT_EQ(p.max_steps, 0);
     EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{5, 15, 30}));
     EXPECT_EQ(p.sourceName, "case.toml");
@@ -285,8 +288,8 @@ TEST(CaseParams, SetValuesAreTomlValues) {
                                         "frames_da_over_d=[1,2.5]", "rods_breakable=false", "seed=7",
                                         "description=a free text"});
     EXPECT_EQ(p.theta_D, 15.0);
-    EXPECT_EQ(p.integrator, "lumped");  // not valid TOML: taken as a string
-    EXPECT_EQ(p.linear_solver, "umfpack");
+    EXPECT_EQ(p.integrator, IntegratorScheme::lumped);  // not valid TOML: taken as a string
+    EXPECT_EQ(p.linear_solver, LinearSolver::umfpack);
     EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{1, 2.5}));
     EXPECT_FALSE(p.rods_breakable);
     EXPECT_EQ(p.seed, 7);
@@ -314,7 +317,7 @@ TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
     EXPECT_EQ(converged.w_s_over_d, 80.0);
     EXPECT_EQ(converged.h_s_over_d, 80.0);
     EXPECT_EQ(converged.v_app_over_cd, 1e-3);
-    EXPECT_EQ(converged.integrator, "lumped");
+    EXPECT_EQ(converged.integrator, IntegratorScheme::lumped);
     EXPECT_EQ(converged.static_start, 0.95);
     EXPECT_EQ(converged.stop_da_over_d, 30.0);
     const CaseParams paper = parse("", "paper");
@@ -327,7 +330,6 @@ TEST(CaseParams, PresetsParseAndSetNumericsOnly) {
 // table itself, so the only way to make that mistake is to add a field beside the three provenance
 // strings: this fails to compile when CaseParams holds anything more than the table's fields and those.
 namespace {
-using enamel::KeyValue;
 struct TableFieldsOnly {
     ENAMEL_CASE_KEYS(ENAMEL_CASE_FIELD)
 };
@@ -382,11 +384,9 @@ TEST(CaseParams, KeyTableHasOneRowPerKeyWithUnitMeaningAndDefaultInRange) {
                 for (const double x : xs) EXPECT_TRUE(inRange(x)) << x;
                 break;
             }
-            case Kind::Choice: {
-                const std::string value = defaults.*std::get<std::string CaseParams::*>(s.field);
-                EXPECT_NE(("|" + choices + "|").find("|" + value + "|"), std::string::npos) << value;
+            case Kind::Choice:
+                EXPECT_LT(std::get<enamel::ChoiceField>(s.field).get(defaults), enamel::splitEnumNames(choices).size());
                 break;
-            }
             case Kind::Bool:
             case Kind::Text: break;
         }
@@ -420,9 +420,7 @@ TEST(CaseParams, FuzzDictionaryAndSeedNameEveryKey) {
         if (line.rfind("key_", 0) == 0) dictNames.insert(line.substr(4, line.find('=') - 4));
     EXPECT_EQ(dictNames, tableNames);
     for (const KeySpec& s : enamel::caseKeys()) {
-        std::istringstream choices(s.choices);
-        std::string choice;
-        while (std::getline(choices, choice, '|'))
+        for (const std::string& choice : enamel::splitEnumNames(s.choices))
             EXPECT_NE(dict.find("=\"\\\"" + choice + "\\\"\"\n"), std::string::npos) << s.name << ": " << choice;
     }
     const CaseParams all = parseCase(seed, "all_keys_effective.toml", "", {});
@@ -455,7 +453,7 @@ TEST(CaseParams, EffectiveTomlRoundTrips) {
     EXPECT_EQ(q.description, "quote \" and\nnewline");
     EXPECT_EQ(q.cv, 0.1);
     EXPECT_EQ(q.w_s_over_d, 40.0);
-    EXPECT_EQ(q.integrator, "lumped");
+    EXPECT_EQ(q.integrator, IntegratorScheme::lumped);
     EXPECT_EQ(q.frames_da_over_d, (std::vector<double>{1, 2.5}));
     EXPECT_EQ(q.max_steps, 12345);
     EXPECT_EQ(q.sigma_ru_over_sigma0, 21.4);  // shortest round-trip formatting keeps every bit
@@ -528,9 +526,9 @@ TEST(CaseParams, SofteningOverDelta0RangeDependsOnGamma) {
 }
 
 TEST(CaseParams, RodStressChoices) {
-    EXPECT_EQ(parse("").rod_stress, "axial_bending");
-    EXPECT_EQ(parse("", "", {"rod_stress=principal"}).rod_stress, "principal");
-    EXPECT_EQ(parse("rod_stress = \"axial\"\n").rod_stress, "axial");
+    EXPECT_EQ(parse("").rod_stress, RodStress::axial_bending);
+    EXPECT_EQ(parse("", "", {"rod_stress=principal"}).rod_stress, RodStress::principal);
+    EXPECT_EQ(parse("rod_stress = \"axial\"\n").rod_stress, RodStress::axial);
     const auto e = caseErrorOf([] { parse("rod_stress = \"von_mises\"\n"); });
     EXPECT_EQ(e.exitCode, exit_code::out_of_range);
     expectMessage(e, {"'rod_stress'", "\"von_mises\"", "\"axial_bending\"", "\"axial\"", "\"principal\""});
@@ -542,12 +540,12 @@ TEST(CaseParams, RodStressChoices) {
 TEST(CaseParams, ModelReadingKeysDefaultsAndBadValues) {
     const CaseParams d = parse("");
     EXPECT_EQ(d.shear_strength_ratio, 1.0);
-    EXPECT_EQ(d.grip_constraint, "uy");
-    EXPECT_EQ(d.grip_profile, "to_right_edge");
+    EXPECT_EQ(d.grip_constraint, GripConstraint::uy);
+    EXPECT_EQ(d.grip_profile, GripProfile::to_right_edge);
     const CaseParams set = parse("shear_strength_ratio = 2.5\ngrip_constraint = \"uxuy\"\ngrip_profile = \"about_centre\"\n");
     EXPECT_EQ(set.shear_strength_ratio, 2.5);
-    EXPECT_EQ(set.grip_constraint, "uxuy");
-    EXPECT_EQ(set.grip_profile, "about_centre");
+    EXPECT_EQ(set.grip_constraint, GripConstraint::uxuy);
+    EXPECT_EQ(set.grip_profile, GripProfile::about_centre);
     EXPECT_EQ(parse("", "", {"shear_strength_ratio=10"}).shear_strength_ratio, 10.0);
     for (const char* bad : {"0", "-1", "10.5", "nan"}) {
         const auto e = caseErrorOf([&] { parse("", "", {std::string("shear_strength_ratio=") + bad}); });
@@ -563,6 +561,73 @@ TEST(CaseParams, ModelReadingKeysDefaultsAndBadValues) {
     const auto type = caseErrorOf([] { parse("grip_profile = 1\n"); });
     EXPECT_EQ(type.exitCode, exit_code::wrong_type);
     expectMessage(type, {"'grip_profile'", "wrong type"});
+}
+
+// Every Choice key parses to its enum (choices.hpp): each allowed value, from a case file and from --set, gives
+// the field the enumerator of that name, and the effective case writes the name back; the enumerators are the
+// names in order. No Choice key is left a string.
+TEST(CaseParams, EveryChoiceParsesToTheEnumeratorOfItsName) {
+    std::size_t choiceKeys = 0;
+    for (const KeySpec& s : enamel::caseKeys()) {
+        if (s.kind != Kind::Choice) continue;
+        SCOPED_TRACE(s.name);
+        ++choiceKeys;
+        ASSERT_TRUE(std::holds_alternative<enamel::ChoiceField>(s.field)) << "a Choice key's field is its enum";
+        const auto names = enamel::splitEnumNames(s.choices);
+        ASSERT_GE(names.size(), 2u);
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const std::string line = std::string(s.name) + " = \"" + names[i] + "\"";
+            const CaseParams fromFile = parse(line + "\n");
+            const CaseParams fromSet = parse("", "", {std::string(s.name) + "=" + names[i]});
+            EXPECT_EQ(std::get<enamel::ChoiceField>(s.field).get(fromFile), i) << names[i];
+            EXPECT_EQ(std::get<enamel::ChoiceField>(s.field).get(fromSet), i) << names[i];
+            EXPECT_NE(fromFile.tomlText.find("\n" + line + "\n"), std::string::npos) << fromFile.tomlText;
+        }
+    }
+    EXPECT_EQ(choiceKeys, 9u);
+    EXPECT_EQ(parse("deletion_rule = \"all\"\n").deletion_rule, DeletionRule::all);
+    EXPECT_EQ(parse("far_field_rod_breaks = \"allow\"\n").far_field_rod_breaks, FarFieldRodBreaks::allow);
+    EXPECT_EQ(parse("").far_field_rod_breaks, FarFieldRodBreaks::stop);
+    EXPECT_EQ(parse("crisscross_at_tip = \"cut\"\n").crisscross_at_tip, CrisscrossAtTip::cut);
+    EXPECT_EQ(parse("section = \"circle\"\n").section, SectionShape::circle);
+    EXPECT_EQ(parse("", "", {"linear_solver=umfpack"}).linear_solver, LinearSolver::umfpack);
+}
+
+// A value that is not one of a Choice key's names: one line naming the source, the key, the value and every
+// allowed value, exit status out_of_range; a name differing only in case is not one of them.
+TEST(CaseParams, BadChoiceIsOneLineNamingKeyValueAndAllowedValues) {
+    for (const KeySpec& s : enamel::caseKeys()) {
+        if (s.kind != Kind::Choice) continue;
+        SCOPED_TRACE(s.name);
+        const auto names = enamel::splitEnumNames(s.choices);
+        std::string upper = names[0];
+        for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        for (const std::string& bad : {std::string("no_such_value"), upper}) {
+            const auto e = caseErrorOf([&] { parse(std::string(s.name) + " = \"" + bad + "\"\n"); });
+            EXPECT_EQ(e.exitCode, exit_code::out_of_range);
+            std::vector<std::string> pieces = {"case.toml: key '" + std::string(s.name) + "' = \"" + bad + "\"",
+                                               "is not a valid choice; allowed one of "};
+            for (const std::string& n : names) pieces.push_back("\"" + n + "\"");
+            expectMessage(e, pieces);
+        }
+    }
+    const auto e = caseErrorOf([] { parse("", "", {"integrator=leapfrog"}); });
+    EXPECT_EQ(std::string(e.what()),
+              "--set integrator=leapfrog: key 'integrator' = \"leapfrog\" is not a valid choice; allowed one of "
+              "\"paper\", \"lumped\"");
+}
+
+// The names of a named enum are the text of its enumerators, in order; a name parses back to its enumerator.
+TEST(NamedEnum, NamesAreTheEnumeratorsInOrder) {
+    EXPECT_EQ(enamel::splitEnumNames("a, b_c,  d"), (std::vector<std::string>{"a", "b_c", "d"}));
+    EXPECT_EQ(enamel::enumNames<RodStress>(), (std::vector<std::string>{"axial_bending", "axial", "principal"}));
+    EXPECT_EQ(nameOf(RodStress::principal), "principal");
+    EXPECT_EQ(nameOf(GripProfile::about_centre), "about_centre");
+    EXPECT_EQ(nameOf(static_cast<RodStress>(3)), "?");
+    EXPECT_EQ(enamel::enumFromName<DeletionRule>("all"), DeletionRule::all);
+    EXPECT_EQ(enamel::enumFromName<DeletionRule>("most_overloaded"), DeletionRule::most_overloaded);
+    EXPECT_FALSE(enamel::enumFromName<DeletionRule>("All").has_value());
+    EXPECT_FALSE(enamel::enumFromName<DeletionRule>("").has_value());
 }
 
 // A key at its default counts as not given in a checkpoint's identity (isDefaultKeyLine): every optional key's

@@ -1,7 +1,7 @@
-// The integrators' registry (solver/lib/integrators/registry.cpp): the table of schemes by name is the one the
-// `integrator` key offers, each name builds its own scheme, and an unknown name is refused with the list. The
-// step's phase timers (step_timers.hpp): laps cover what lies between them, and a step with timers gives the same
-// numbers as one without, its scheme's phases timed and no other's.
+// The integrators' registry (solver/lib/integrators/registry.cpp): one row per enumerator of IntegratorScheme (the
+// `integrator` key's choices, choices.hpp), in order; each builds its own scheme, and a value without a row is
+// refused with the list. The step's phase timers (step_timers.hpp): laps cover what lies between them, and a step
+// with timers gives the same numbers as one without, its scheme's phases timed and no other's.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -27,35 +27,33 @@ CaseParams smallCase(const std::string& integrator) {
 
 }  // namespace
 
-TEST(Integrators, RegistryNamesAreTheIntegratorKeysChoices) {
-  std::string names;
-  std::set<std::string> distinct;
-  for (const IntegratorEntry& e : integratorRegistry()) {
-    names += (names.empty() ? "" : "|") + std::string(e.name);
-    distinct.insert(e.name);
-  }
-  EXPECT_EQ(distinct.size(), integratorRegistry().size());
+TEST(Integrators, RegistryHasOneRowPerIntegratorChoiceInOrder) {
+  const auto& names = enumNames<IntegratorScheme>();
+  ASSERT_EQ(integratorRegistry().size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    EXPECT_EQ(nameOf(integratorRegistry()[i].scheme), names[i]) << "row " << i;
   std::string choices;
   for (const KeySpec& k : caseKeys())
     if (std::string(k.name) == "integrator") choices = k.choices;
-  EXPECT_EQ(names, choices);
+  EXPECT_EQ(splitEnumNames(choices), names) << "the integrator key's choices are IntegratorScheme's names";
+  EXPECT_EQ(smallCase("lumped").integrator, IntegratorScheme::lumped);
 }
 
-TEST(Integrators, EachRegisteredNameBuildsItsSchemeAndAnUnknownOneIsRefused) {
+TEST(Integrators, EachRegisteredSchemeBuildsItselfAndOneWithoutARowIsRefused) {
   for (const IntegratorEntry& e : integratorRegistry()) {
-    Simulation sim(smallCase(e.name));
-    EXPECT_EQ(sim.integrator->name(), e.name);
+    Simulation sim(smallCase(nameOf(e.scheme)));
+    EXPECT_EQ(sim.integrator->name(), nameOf(e.scheme));
     EXPECT_GT(sim.integrator->timeStep(), 0);
     CaseParams other = sim.params;
-    other.integrator = "leapfrog";
+    other.integrator = static_cast<IntegratorScheme>(enumNames<IntegratorScheme>().size());  // no row, no name
     try {
       makeIntegrator(other, sim.model, sim.materials, sim.ops);
-      ADD_FAILURE() << "an unknown integrator was built";
+      ADD_FAILURE() << "an integrator without a row was built";
     } catch (const IntegratorError& err) {
       std::string available;  // the registry's names, in its order
       for (const IntegratorEntry& r : integratorRegistry())
-        available += std::string(available.empty() ? "" : ", ") + r.name;
-      EXPECT_NE(std::string(err.what()).find("'leapfrog' is not available in this build (available: " + available + ")"),
+        available += (available.empty() ? "" : ", ") + nameOf(r.scheme);
+      EXPECT_NE(std::string(err.what()).find("'?' is not available in this build (available: " + available + ")"),
                 std::string::npos)
           << err.what();
     }

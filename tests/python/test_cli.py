@@ -10,7 +10,7 @@ import pytest
 from conftest import CASES
 from enamel_results.constants import EXIT
 
-# Exit statuses, read from solver/lib/exit_codes.hpp (enamel_results.constants).
+# Exit statuses, as the solver prints them (`enamel-dem constants`, read by enamel_results.constants).
 USAGE, MISSING_FILE, MALFORMED, UNKNOWN_KEY, WRONG_TYPE, OUT_OF_RANGE, UNWRITABLE, EXISTS = (
     EXIT[k] for k in ("usage", "missing_file", "malformed_toml", "unknown_key", "wrong_type", "out_of_range",
                       "output_unwritable", "output_exists"))

@@ -135,12 +135,6 @@ def test_result_resolver_order(tmp_path):
     assert paths.run_result(tmp_path, kinds=("failed",)).name == "result.failed.h5"
 
 
-def test_exit_codes_come_from_the_solver_header():
-    text = (ROOT / "solver" / "lib" / "exit_codes.hpp").read_text()
-    assert sum(line.startswith("constexpr int ") for line in text.splitlines()) == len(EXIT) >= 16
-    assert EXIT["missing_file"] == results.EXIT_MISSING == 3 and EXIT["checkpoint_damaged"] == 14
-
-
 # --- a full disk at each write -------------------------------------------------------------------------------
 
 def limited_run(enamel, out, extra, file_limit=None):

@@ -159,7 +159,7 @@ class LumpedIntegrator : public Integrator {
     }
   }
 
-  std::string name() const override { return "lumped"; }
+  std::string name() const override { return nameOf(IntegratorScheme::lumped); }
   double timeStep() const override { return dt_; }
   bool usesConsistentMass() const override { return false; }
   bool usesHalfStepVelocity() const override { return true; }

@@ -44,7 +44,7 @@ SpMat selectRows(const SpMat& A, const std::vector<int>& rows) {
 class PaperIntegrator : public Integrator {
  public:
   PaperIntegrator(const CaseParams& p, const Materials& mat, const Operators& ops)
-      : useUmfpack_(p.linear_solver == "umfpack"), dampA_(mat.dampA), dampB_(mat.dampB) {
+      : useUmfpack_(p.linear_solver == LinearSolver::umfpack), dampA_(mat.dampA), dampB_(mat.dampB) {
     dt_ = p.dt_factor * 2.0 * M_PI / mat.omegaMaxElement;
     const double limit = 2.0 / mat.omegaMaxElement;
     // Interfaces add stiffness (about k A_i per node against E A / L for the beams): keep 5% margin.
@@ -59,7 +59,7 @@ class PaperIntegrator : public Integrator {
     factorise(ops, true);
   }
 
-  std::string name() const override { return "paper"; }
+  std::string name() const override { return nameOf(IntegratorScheme::paper); }
   double timeStep() const override { return dt_; }
 
   // The step as the class comment lists it; each lap books the calls before it to their phase (step_timers.hpp).

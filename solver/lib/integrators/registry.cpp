@@ -1,5 +1,6 @@
-// The schemes of this build by name: the one table makeIntegrator looks in (a scheme is one row here and its
-// name among the `integrator` key's choices, case_params.hpp; tests/cpp/test_integrators.cpp checks both agree).
+// The schemes of this build: the one table makeIntegrator looks in (a scheme is one row here and one enumerator
+// of IntegratorScheme, choices.hpp, whose name is the `integrator` key's value; tests/cpp/test_integrators.cpp
+// checks that every enumerator has its row, in order).
 #include <string>
 #include <vector>
 
@@ -10,8 +11,8 @@ namespace enamel {
 
 const std::vector<IntegratorEntry>& integratorRegistry() {
   static const std::vector<IntegratorEntry> table = {
-      {"paper", makePaperIntegrator},
-      {"lumped", makeLumpedIntegrator},
+      {IntegratorScheme::paper, makePaperIntegrator},
+      {IntegratorScheme::lumped, makeLumpedIntegrator},
   };
   return table;
 }
@@ -20,11 +21,11 @@ std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, 
                                            const Operators& ops) {
   std::string available;
   for (const IntegratorEntry& e : integratorRegistry()) {
-    if (p.integrator == e.name) return e.make(p, m, mat, ops);
-    available += (available.empty() ? "" : ", ") + std::string(e.name);
+    if (p.integrator == e.scheme) return e.make(p, m, mat, ops);
+    available += (available.empty() ? "" : ", ") + nameOf(e.scheme);
   }
-  throw IntegratorError("integrator '" + p.integrator + "' is not available in this build (available: " + available +
-                        ")");
+  throw IntegratorError("integrator '" + nameOf(p.integrator) + "' is not available in this build (available: " +
+                        available + ")");
 }
 
 }  // namespace enamel
