@@ -1,0 +1,173 @@
+"""The margin-rule study (README.md here): its runs, their records and the report.
+
+    python3 -m research.rate.rate run --preset reduced --case theta30_s21.4_e10_cv0 --candidate margin8
+    python3 -m research.rate.rate all --preset reduced      # every case and candidate in the README's order
+    python3 -m research.rate.rate report                    # the table, from data/
+
+A run goes to runs/rate/PRESET/CASE/CANDIDATE (niced, one thread, checkpointed, --resume); its record to
+data/PRESET__CASE__CANDIDATE.json: the keys, steps, the solver's wall and core seconds, the machine, phi at the
+events (statement S3) and the R-curve to 10 digits, so that the report (S1, S2 against phi1) needs no run folder.
+A recorded candidate is not run again.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pathlib
+import resource
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+from bench import records
+from enamel_results import metrics, paths
+
+HERE = pathlib.Path(__file__).resolve().parent
+DATA = HERE / "data"
+RUNS = paths.RUNS / "rate"
+CASES = ("theta30_s21.4_e10_cv0", "theta15_s21.4_e10_cv0")
+CANDIDATES = {   # README.md, Candidates; the order is the README's
+    "phi1": {"rate_adapt_max": 1},
+    "margin8": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 10},
+    "energy8": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 8},
+    "margin4": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 4, "rate_adapt_horizon": 10},
+    "margin16": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 16, "rate_adapt_horizon": 10},
+    "energy4": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 4},
+    "energy16": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 16},
+}
+STATIC_START = {"reduced": 0.95, "ci": 0.0}   # reduced starts as converged does; the ci smoke run as its preset
+
+
+def solver_args(binary: str, case: str, preset: str, candidate: str, out: pathlib.Path) -> list[str]:
+    sets = {"threads": 1, "static_start": STATIC_START.get(preset, 0.0), **CANDIDATES[candidate]}
+    args = ["nice", "-n", "5", binary, "run", str(paths.case_file(case)), "--preset", preset, "--out", str(out),
+            "--resume", "--quiet", "--checkpoint-every", "120"]
+    for k, v in sets.items():
+        args += ["--set", f"{k}={v}"]
+    return args
+
+
+def events_at_phi(h5: pathlib.Path) -> dict:
+    """Statement S3: phi at both ends of the history interval of the first rod break and of the first interface
+    failure, and how many intervals with an event (a rod broke or an interface failed in it) have phi = 1 at
+    both ends."""
+    with h5py.File(h5, "r") as f:
+        h = f["history"]
+        rods, failed, phi = (np.asarray(h[k]) for k in ("broken_rod_elements", "failed_interfaces", "rate_multiplier"))
+    rows = np.nonzero((np.diff(rods) > 0) | (np.diff(failed) > 0))[0] + 1   # row i: the event in (row i-1, row i]
+
+    def ends(count):
+        i = int(np.argmax(count > 0)) if (count > 0).any() else None
+        return None if i is None or i == 0 else [float(phi[i - 1]), float(phi[i])]
+    at_one = int(sum(phi[i - 1] == 1 and phi[i] == 1 for i in rows))
+    return dict(first_rod_break=ends(rods), first_interface_failure=ends(failed), intervals=int(len(rows)),
+                intervals_at_one=at_one, phi_max_reached=float(phi.max()))
+
+
+def s3_holds(ev: dict) -> bool:
+    return all(e is None or e == [1.0, 1.0] for e in (ev["first_rod_break"], ev["first_interface_failure"]))
+
+
+def record(preset: str, case: str, candidate: str, out: pathlib.Path, core_s: float | None) -> dict:
+    h5 = out / "result.h5"
+    rec = records.record_of(h5, f"{preset}__{case}__{candidate}")
+    rec.update(preset=preset, candidate=candidate, keys=CANDIDATES[candidate], cpu=records.cpu_model(),
+               core_seconds=core_s, recorded=time.strftime("%Y-%m-%d"), events=events_at_phi(h5))
+    DATA.mkdir(exist_ok=True)
+    (DATA / f"{rec['name']}.json").write_text(json.dumps(rec, indent=1))
+    return rec
+
+
+def run_one(binary: str, preset: str, case: str, candidate: str) -> int:
+    name = f"{preset}__{case}__{candidate}"
+    if (DATA / f"{name}.json").exists():
+        print(f"rate: {name} is recorded")
+        return 0
+    out = RUNS / preset / case / candidate
+    out.mkdir(parents=True, exist_ok=True)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with open(out / "log.txt", "a") as log:
+        rc = subprocess.run(solver_args(binary, case, preset, candidate, out), stderr=log).returncode
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if rc != 0:
+        print(f"rate: {name} exited with status {rc} (log: {out / 'log.txt'})", file=sys.stderr)
+        return rc
+    resumed = "resuming from checkpoint" in (out / "log.txt").read_text()
+    core = None if resumed else after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    r = record(preset, case, candidate, out, core)
+    print(f"rate: {name}: {r['meta']['steps']} steps, {core} core s, events {r['events']}")
+    return 0
+
+
+def curve(rec: dict) -> metrics.RCurve:
+    return metrics.RCurve.of(rec["da"], rec["R"], broken_rods=rec["broken_rods"])
+
+
+def rows() -> list[dict]:
+    """Each record against the phi1 record of its preset and case: S1, S2 (the measure's numbers), S3."""
+    recs = {p.stem: json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))}
+    out = []
+    for name, r in recs.items():
+        ref = recs.get(f"{r['preset']}__{r['case']}__phi1")
+        row = dict(name=name, preset=r["preset"], case=r["case"], candidate=r["candidate"], steps=r["meta"]["steps"],
+                   core_s=r["core_seconds"], cpu=r["cpu"], s3=s3_holds(r["events"]), events=r["events"])
+        if ref is not None:
+            c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
+            row.update(steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"],
+                       core_ratio=(ref["core_seconds"] / r["core_seconds"]) if ref["core_seconds"] and r["core_seconds"] else None,
+                       mean_rel=c.mean_rel, init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, hi=c.hi,
+                       comparable=c.comparable, same=c.same)
+        out.append(row)
+    return out
+
+
+def report() -> str:
+    lines = ["| preset | case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand |"
+             " L2 | same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 13]
+    for w in rows():
+        ev = w["events"]
+        fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
+        if "steps_ratio" in w:
+            cmp_ = (f"{w['steps_ratio']:.2f} | {w['core_s'] or float('nan'):.0f} | {100 * w['mean_rel']:+.2f} % | "
+                    f"{100 * w['init_rel']:+.2f} % | {w['rods'][0]}/{w['rods'][1]} | {w['l2']:.3f} | "
+                    f"{'yes' if w['same'] else ('no' if w['comparable'] else 'not comparable')}")
+        else:
+            cmp_ = f"- | {w['core_s'] or float('nan'):.0f} | - | - | - | - | no reference"
+        lines.append(f"| {w['preset']} | {w['case']} | {w['candidate']} | {w['steps']} | {cmp_} | "
+                     f"{fmt(ev['first_rod_break'])}, {fmt(ev['first_interface_failure'])} "
+                     f"({'holds' if w['s3'] else 'fails'}) | {ev['intervals_at_one']}/{ev['intervals']} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python3 -m research.rate.rate", description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    one = sub.add_parser("run", help="run one candidate on one case (resumable) and record it")
+    one.add_argument("--preset", default="reduced")
+    one.add_argument("--case", choices=CASES, required=True)
+    one.add_argument("--candidate", choices=tuple(CANDIDATES), required=True)
+    every = sub.add_parser("all", help="every case and candidate in the README's order, skipping recorded ones")
+    every.add_argument("--preset", default="reduced")
+    for p in (one, every):
+        p.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
+    sub.add_parser("report", help="the table from data/")
+    a = ap.parse_args(argv)
+    if a.cmd == "report":
+        print(report(), end="")
+        return 0
+    if a.cmd == "run":
+        return run_one(a.binary, a.preset, a.case, a.candidate)
+    for case in CASES:
+        for cand in CANDIDATES:
+            rc = run_one(a.binary, a.preset, case, cand)
+            if rc != 0:
+                return rc
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,31 @@
+"""research/rate: a ci run of two candidates through the study's script (solver arguments, record, report): phi at
+the first events (S3), the steps ratio and the measure against phi1 (S1, S2), resumable (a recorded candidate is
+not run again)."""
+import json
+
+from research.rate import rate
+
+
+def test_two_candidates_record_and_report(enamel, tmp_path, monkeypatch):
+    monkeypatch.setattr(rate, "DATA", tmp_path / "data")
+    monkeypatch.setattr(rate, "RUNS", tmp_path / "runs")
+    case = "theta30_s21.4_e10_cv0"
+    for cand in ("phi1", "margin8"):
+        assert rate.run_one(str(enamel), "ci", case, cand) == 0
+    ref = json.loads((tmp_path / "data" / f"ci__{case}__phi1.json").read_text())
+    rec = json.loads((tmp_path / "data" / f"ci__{case}__margin8.json").read_text())
+    assert rec["keys"] == rate.CANDIDATES["margin8"] and rec["core_seconds"] > 0 and rec["cpu"]
+    ev = rec["events"]
+    assert ref["events"]["phi_max_reached"] == 1.0 and 4 < ev["phi_max_reached"] <= 8
+    assert ev["first_interface_failure"] == [1.0, 1.0]          # measured: the first failure runs at phi = 1
+    assert rate.s3_holds(ref["events"])
+    assert rate.s3_holds(ev) == (ev["first_rod_break"] in (None, [1.0, 1.0]))
+    rows = {w["candidate"]: w for w in rate.rows()}
+    assert rows["phi1"]["steps_ratio"] == 1.0 and rows["phi1"]["mean_rel"] == 0.0
+    assert rows["margin8"]["steps_ratio"] > 2 and not rows["margin8"]["comparable"]   # ci: 5 d < the measure's 10 d
+    assert "| ci | theta30_s21.4_e10_cv0 | margin8 |" in rate.report()
+    # resumable: a recorded candidate is not run again (the run folder is not touched)
+    log = tmp_path / "runs" / "ci" / case / "margin8" / "log.txt"
+    before = log.stat().st_mtime_ns
+    assert rate.run_one(str(enamel), "ci", case, "margin8") == 0
+    assert log.stat().st_mtime_ns == before
