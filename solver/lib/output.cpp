@@ -119,13 +119,6 @@ const std::vector<HistoryColumn>& historyColumns() {
        "crack plane: kinks along the rods, against failed interfaces across the plane"},
       {"rate_multiplier", &M::rateMultiplier, "-",
        "phi: the adaptive loading rate's multiplier of v_app (dU/dt = phi U'(tau); 1 when rate_adapt_max = 1)"},
-      {"rate_rows_to_rod_break", &M::rowsToRodBreak, "history rows at phi = 1",
-       "the adaptive rate's margin rule (rate_adapt_rule = margin): the rows of loading at v_app until the first "
-       "rod element reaches its strength, each element's stress / strength extrapolated from its rise since the "
-       "last row (inf: none rose; NaN: not forecast, the other rules, the first and last rows)"},
-      {"rate_rows_to_interface_failure", &M::rowsToInterfaceFailure, "history rows at phi = 1",
-       "as rate_rows_to_rod_break, for the first interface to fail: each interface's effective separation / "
-       "delta_f"},
       {"inelastic_reach_over_d", &M::inelasticReach, "d",
        "largest distance |y - y_crack| from the crack plane of an interface past delta0 or a broken rod element "
        "(midpoints of their nodes' reference positions); h_s/2 is the loaded edge"},

@@ -29,8 +29,6 @@ struct Measurement {
   double load = 0;      // generalised force conjugate to U: sum of F_y * (+/-)(1 - x/w_s)
   double rateMultiplier = 1;  // phi of the adaptive loading rate (loading_rate.hpp; 1 when off)
   double inelasticReach = 0;  // largest |y - y_crack| of an inelastic interface or broken rod element (d)
-  // the margin rule's forecast (loading_rate.hpp EventForecast; NaN when rate_adapt_rule is not margin)
-  double rowsToRodBreak = NAN, rowsToInterfaceFailure = NAN;
 };
 
 /// What a static elastic start (case key static_start, Simulation::startFromStaticElastic) did; plain data,
