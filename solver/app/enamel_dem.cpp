@@ -240,6 +240,32 @@ int runRun(const CaseArgs& args, RunFlags flags) {
   return exit_code::ok;
 }
 
+/// `enamel-dem run`: the case's arguments and the run's own flags.
+CLI::App* addRunCommand(CLI::App& app, CaseArgs& runArgs, RunFlags& flags) {
+  CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5 (while it "
+                                            "runs, and when interrupted: DIR/result.partial.h5; failed: "
+                                            "DIR/result.failed.h5)");
+  runArgs.addTo(run);
+  run->add_option("--out,-o", flags.outDir, "output directory (default runs/<preset>/<case name>)");
+  run->add_flag("--force", flags.force, "overwrite an existing result.h5");
+  run->add_flag("--quiet,-q", flags.quiet, "no progress lines");
+  run->add_flag("--restart", flags.restart,
+                "continue from DIR/checkpoint.bin (same case, --preset and --set as the first run); the result "
+                "is the same as an uninterrupted run's, bit for bit at the same thread count");
+  run->add_flag("--resume", flags.resume,
+                "continue from DIR/checkpoint.bin when it was written by this build for this case, otherwise "
+                "start from step 0 (says which on stderr): what the pipeline passes, so a killed run continues");
+  run->add_option("--checkpoint-every", flags.checkpointEvery,
+                  "write DIR/checkpoint.bin every this many wall-clock seconds (default: the case key "
+                  "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--lock-wait", flags.lockWait,
+                  "while another live run holds DIR (its lock DIR/.lock), wait up to this many seconds for it to "
+                  "end (default 0: refused at once, exit status 17, nothing changed)")
+      ->check(CLI::NonNegativeNumber);
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -259,28 +285,8 @@ int main(int argc, char** argv) {
                  "'duration', 'steps', 'seconds_per_step', 'setup_seconds', 'seconds'), without building the model "
                  "(c_d and dt from a block of at most 16 x 8 d of the case)");
 
-  CLI::App* run = app.add_subcommand("run", "run one case to its stop criterion and write DIR/result.h5 (while it "
-                                            "runs, and when interrupted: DIR/result.partial.h5; failed: "
-                                            "DIR/result.failed.h5)");
-  runArgs.addTo(run);
   RunFlags flags;
-  run->add_option("--out,-o", flags.outDir, "output directory (default runs/<preset>/<case name>)");
-  run->add_flag("--force", flags.force, "overwrite an existing result.h5");
-  run->add_flag("--quiet,-q", flags.quiet, "no progress lines");
-  run->add_flag("--restart", flags.restart,
-                "continue from DIR/checkpoint.bin (same case, --preset and --set as the first run); the result "
-                "is the same as an uninterrupted run's, bit for bit at the same thread count");
-  run->add_flag("--resume", flags.resume,
-                "continue from DIR/checkpoint.bin when it was written by this build for this case, otherwise "
-                "start from step 0 (says which on stderr): what the pipeline passes, so a killed run continues");
-  run->add_option("--checkpoint-every", flags.checkpointEvery,
-                  "write DIR/checkpoint.bin every this many wall-clock seconds (default: the case key "
-                  "checkpoint_interval_s; a checkpoint is always written on SIGINT/SIGTERM)")
-      ->check(CLI::NonNegativeNumber);
-  run->add_option("--lock-wait", flags.lockWait,
-                  "while another live run holds DIR (its lock DIR/.lock), wait up to this many seconds for it to "
-                  "end (default 0: refused at once, exit status 17, nothing changed)")
-      ->check(CLI::NonNegativeNumber);
+  CLI::App* run = addRunCommand(app, runArgs, flags);
 
   CaseArgs profileArgs;
   long profileWarmup = 200, profileSteps = 100;
