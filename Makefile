@@ -24,8 +24,9 @@
 #                       BENCH_G=3): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
 #                       cases at the `converged` preset to Delta_a = 30 d, each by c09beab's build (built once in
-#                       build/baseline-c09beab/) and by build/enamel-dem with CONVERGED_SET, one thread a run, JOBS
-#                       at once, resumable (6 runs of 23-37 min at c09beab's speed): bench/converged_cost.md, .csv
+#                       build/baseline-c09beab/: the cost's baseline), by build/enamel-dem with CONVERGED_SET (new)
+#                       and without it (the R-curve's reference; --reference-set in CONVERGED_ARGS), one thread a
+#                       run, JOBS at once, resumable (6-9 runs of 23-37 min at c09beab's speed): bench/converged_cost.md
 #   make bench-step     instructions and cache misses per phase of the step, per DOF and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
 #   make bench-paper    one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a = 30 d at the preset's rate

@@ -2,18 +2,27 @@
 """`make bench-converged`: what a converged run costs, an older solver's build against this one.
 
 Three cases (CASES: theta_D = 30 and 15 at sigma_ru/sigma0 = 21.4, Er/kd = 10, and theta_D = 30 at 28.5 with
-strengths scattered by cv = 0.3, seed 1) run at the `converged` preset (80 x 80 d, to Delta_a = 30 d) twice:
-by the baseline, the build of commit c09beab (--baseline; built once, from a detached git worktree, into
-build/baseline-<commit>/, and reused), and by the new solver (build/enamel-dem, or ENAMEL_BINARY) with the
---set overrides that make "the new default". One thread a run, --jobs runs at once, the baseline's runs first.
+strengths scattered by cv = 0.3, seed 1) run at the `converged` preset (80 x 80 d, to Delta_a = 30 d) by three
+roles of solver:
+- the baseline, the build of commit c09beab (--baseline; built once, from a detached git worktree, into
+  build/baseline-<commit>/, and reused): what the cost is compared with;
+- the new solver (build/enamel-dem, or ENAMEL_BINARY) with the --set overrides that make "the new default";
+- the reference, the new solver with --reference-set (its speed levers off; none: its defaults): what the new
+  R-curve is compared with. The baseline's model is not today's (the pre-crack's tip rule changed after c09beab,
+  so its R-curve differs at equal numerics), so the R-curve is judged against today's model at the preset's
+  numerics, and the baseline's R-curve is reported beside it. When the reference's command is the new one's
+  (no --set and no --reference-set), the new run is its own reference and is not run twice.
+One thread a run, --jobs runs at once, the baseline's runs first.
 
 Per run: core-seconds (the solver process's own CPU time, user + system, from os.wait4, summed over the pieces
 of a resumed run), wall seconds, steps and DOF (the result file's /meta), the machine (CPU model), the start of
 each piece (UTC) and the solver's commit. Per case: the ratio of core-seconds (baseline / new), its two factors
 (fewer steps; cheaper steps), and "the same R-curve" by enamel_results.metrics.same_rcurve at the rate-and-speed
 tolerance (R averaged over (0,30] d and R_init within 2%, broken rods within 20%; the pointwise L2 reported,
-not deciding), computed as `make bench` computes it (bench.run_bench.speed_comparison). The verdict: the ratio
-at least --goal (3) and the same R-curve; a case that misses says what it reached and by which factor.
+not deciding) against the reference, computed as `make bench` computes it (bench.run_bench.speed_comparison);
+the levers' own ratio (reference / new core-seconds) and the baseline's R-curve against the new one beside it.
+The verdict: the ratio at least --goal (3) and the same R-curve as the reference; a case that misses says what
+it reached and by which factor.
 
 Resumable: each run goes to RUNS/<preset>/<role>_<solver commit>[_<sets>]/<case>/ with the solver's checkpoints
 (--checkpoint-every) and its --resume; Ctrl-C or SIGTERM stops every run at a checkpoint, and the same command
@@ -83,14 +92,27 @@ def solver_commit(binary: pathlib.Path) -> str:
     return m.group(1) if m else "unknown"
 
 
-class Variant:
-    """One solver with its --set overrides: role ("baseline" or "new"), binary, sets (["key=value", ...])."""
+ROLES = ("baseline", "reference", "new")
 
-    def __init__(self, role: str, binary: pathlib.Path, sets: list[str]):
-        self.role, self.binary, self.sets = role, pathlib.Path(binary), list(sets)
+
+class Variant:
+    """One solver with its --set overrides: role (one of ROLES), binary, sets (["key=value", ...]). `same_as`: the
+    variant whose runs stand for this one's (the reference whose command is the new one's), else None."""
+
+    def __init__(self, role: str, binary: pathlib.Path, sets: list[str], same_as: "Variant | None" = None):
+        self.role, self.binary, self.sets, self.same_as = role, pathlib.Path(binary), list(sets), same_as
         self.commit = solver_commit(self.binary)
         tag = re.sub(r"[^\w.-]", "", set_tag(self.sets))
-        self.label = f"{role}_{self.commit}" + (f"_{tag}" if tag else "")
+        self.label = same_as.label if same_as else f"{role}_{self.commit}" + (f"_{tag}" if tag else "")
+
+
+def variants_of(base_binary: pathlib.Path, binary: pathlib.Path, set_both: list[str], new_sets: list[str],
+                reference_sets: list[str]) -> list[Variant]:
+    """The three roles in ROLES's order; the reference is the new variant itself when their commands agree."""
+    base = Variant("baseline", base_binary, set_both)
+    new = Variant("new", binary, set_both + new_sets)
+    ref_sets = set_both + reference_sets
+    return [base, Variant("reference", binary, ref_sets, same_as=new if ref_sets == new.sets else None), new]
 
 
 def solver_args(v: Variant, case: str, preset: str, out: pathlib.Path, checkpoint_every: float) -> list[str]:
@@ -146,7 +168,7 @@ def run_all(variants: list[Variant], cases, preset: str, runs: pathlib.Path, job
     """Every case by every variant, `jobs` at once, the baseline's first; Ctrl-C / SIGTERM: every running solver
     writes its checkpoint and stops, its piece is recorded, and nothing more starts."""
     todo, commands = [], {}
-    for v in variants:
+    for v in (v for v in variants if v.same_as is None):
         for case in cases:
             out = runs / preset / v.label / case
             cmd = solver_args(v, case, preset, out, checkpoint_every)
@@ -157,7 +179,7 @@ def run_all(variants: list[Variant], cases, preset: str, runs: pathlib.Path, job
             wrapped = (["nice", "-n", str(nice)] if nice else []) + cmd   # nice execs: wait4 sees the solver
             commands[str(out)] = cmd
             todo.append(run_bench.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
-                                      expected_s=2.0 if v.role == "baseline" else 1.0))
+                                      expected_s=2.0 if v.role != "new" else 1.0))
     stopping = []
 
     def forward(signum, frame):
@@ -208,23 +230,34 @@ def differences(c: metrics.Comparison) -> str:
     return ", ".join(out + ([] if c.rods_ok else [f"rods {c.rods_a} / {c.rods_b}"]))
 
 
-def case_row(case: str, base: pathlib.Path, new: pathlib.Path, goal: float = RATIO_GOAL) -> dict:
-    """One case's row: both runs' numbers, the ratio and its factors, the comparison and the verdict."""
+def done(out: pathlib.Path) -> bool:
+    return completed(out) and bool(read_record(out).get("pieces"))
+
+
+def case_row(case: str, base: pathlib.Path, ref: pathlib.Path, new: pathlib.Path, goal: float = RATIO_GOAL) -> dict:
+    """One case's row: the three runs' numbers (the reference's folder may be the new one's), the ratio of cost
+    (baseline / new) and its factors, the levers' own ratio (reference / new), the new R-curve against the
+    reference's (deciding) and against the baseline's (reported), and the verdict."""
     row = dict(case=case)
-    if not (completed(base) and completed(new) and read_record(base).get("pieces") and read_record(new).get("pieces")):
+    if not (done(base) and done(ref) and done(new)):
         row.update(status="incomplete", verdict=verdict(math.nan, None, goal)[1], met=False)
         return row
-    b, n = run_row(base), run_row(new)
-    same = run_bench.speed_comparison(b["result"], n["result"])
-    for prefix, x in (("baseline", b), ("new", n)):
+    b, r, n = run_row(base), run_row(ref), run_row(new)
+    same = run_bench.speed_comparison(r["result"], n["result"])
+    was = run_bench.speed_comparison(b["result"], n["result"])
+    for prefix, x in (("baseline", b), ("reference", r), ("new", n)):
         row.update({f"{prefix}_{k}": (";".join(v) if k == "machines" else v) for k, v in x.items() if k != "result"})
     ratio = b["core_s"] / n["core_s"]
     row.update(status="complete", ratio=ratio, fewer_steps=b["steps"] / n["steps"],
-               cheaper_step=(b["core_s"] / b["steps"] / b["dof"]) / (n["core_s"] / n["steps"] / n["dof"]))
+               cheaper_step=(b["core_s"] / b["steps"] / b["dof"]) / (n["core_s"] / n["steps"] / n["dof"]),
+               lever_ratio=r["core_s"] / n["core_s"], reference_is_new=(ref == new))
     if same is not None:
-        row.update(range_hi=same.hi, R_mean_baseline=same.mean_a, R_mean_new=same.mean_b, R_mean_rel=same.mean_rel,
-                   R_init_rel=same.init_rel, rods_baseline=same.rods_a, rods_new=same.rods_b, rcurve_l2=same.l2,
+        row.update(range_hi=same.hi, R_mean_reference=same.mean_a, R_mean_new=same.mean_b, R_mean_rel=same.mean_rel,
+                   R_init_rel=same.init_rel, rods_reference=same.rods_a, rods_new=same.rods_b, rcurve_l2=same.l2,
                    same_rcurve=same.same)
+    if was is not None:
+        row.update(R_mean_baseline=was.mean_a, baseline_R_mean_rel=was.mean_rel, baseline_R_init_rel=was.init_rel,
+                   rods_baseline=was.rods_a, same_as_baseline=was.same)
     met, words = verdict(ratio, same.same if same else None, goal, differences(same) if same else "")
     return dict(row, met=met, verdict=words)
 
@@ -242,34 +275,47 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"{header['G']}; 1 thread a run (threads=1, {' '.join(f'{k}=1' for k in ONE_THREAD_ENV)}), "
          f"{header['jobs']} runs at once{header['nice']}; `make bench-converged` "
          f"(bench/converged_cost.py). Baseline: the build of {header['baseline']} (solver {header['baseline_git']}). "
-         f"New: solver {header['new_git']}{header['new_sets']}. Core-seconds: the solver process's CPU time "
-         f"(user + system) summed over its pieces; ratio = baseline / new = fewer steps x cheaper step (core-s per "
-         f"step and DOF). Same R-curve: `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged over "
-         f"(0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
-         f"pointwise L2 reported, not deciding. Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
-         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | steps (baseline / new) "
-         "| DOF | R mean over (0, hi] d: baseline / new (diff) | R_init diff | broken rods | L2 | same R-curve "
-         "| verdict |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        if r.get("status") != "complete":
-            L.append(f"| {r['case']} | | | | | | | | | | | | | {r['verdict']} |")
-            continue
-        dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
-        L.append(f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
-                 f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['baseline_steps']} / {r['new_steps']} | "
-                 f"{dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_baseline'), '.4g')} / "
-                 f"{fmt(r.get('R_mean_new'), '.4g')} ({fmt(r.get('R_mean_rel', math.nan) * 100, '+.2f')}%) | "
-                 f"{fmt(r.get('R_init_rel', math.nan) * 100, '+.2f')}% | {r.get('rods_baseline')} / "
-                 f"{r.get('rods_new')} | {fmt(r.get('rcurve_l2', math.nan) * 100, '.2f')}% | "
-                 f"{r.get('same_rcurve')} | {r['verdict']} |")
+         f"New: solver {header['new_git']}{header['new_sets']}. Reference: {header['reference']}. Core-seconds: the "
+         f"solver process's CPU time (user + system) summed over its pieces; ratio = baseline / new = fewer steps x "
+         f"cheaper step (core-s per step and DOF); levers = reference / new. Same R-curve, new against the "
+         f"reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged over (0,30] d "
+         f"and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the pointwise L2 "
+         f"reported, not deciding; the baseline's R mean against the new one reported beside it (its model is not "
+         f"today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
+         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | steps (baseline / "
+         "new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | broken rods (reference / new) "
+         "| L2 | same R-curve | baseline's R mean (diff) | verdict |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    L += [table_line(r) for r in rows]
     L += ["", "Per run (pieces: solver processes of a resumed run; started: the first piece, UTC):", ""]
     for r in rows:
-        for role in ("baseline", "new") if r.get("status") == "complete" else ():
+        for role in ROLES if r.get("status") == "complete" else ():
+            if role == "reference" and r["reference_is_new"]:
+                L.append(f"- {r['case']}, reference: the new run (the same command)")
+                continue
             L.append(f"- {r['case']}, {role}: solver {r[f'{role}_git']}, {r[f'{role}_pieces']} piece(s) from "
                      f"{r[f'{role}_started_utc']}, {r[f'{role}_core_s']:.1f} core-s, {r[f'{role}_wall_s']:.1f} s "
-                     f"wall, {r[f'{role}_threads']} thread, G = {r[f'{role}_G']:g}, {r[f'{role}_machines']}")
+                     f"wall, {r[f'{role}_steps']} steps, {r[f'{role}_threads']} thread, G = {r[f'{role}_G']:g}, "
+                     f"{r[f'{role}_machines']}")
     return "\n".join(L) + "\n"
+
+
+def pct(v) -> str:
+    return fmt(v * 100 if v is not None else None, "+.2f") + "%"
+
+
+def table_line(r: dict) -> str:
+    """One case's line of the table."""
+    if r.get("status") != "complete":
+        return f"| {r['case']} |" + " |" * 14 + f" {r['verdict']} |"
+    dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
+    return (f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
+            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {r['baseline_steps']} / "
+            f"{r['new_steps']} | {dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_reference'), '.4g')} "
+            f"/ {fmt(r.get('R_mean_new'), '.4g')} ({pct(r.get('R_mean_rel'))}) | {pct(r.get('R_init_rel'))} | "
+            f"{r.get('rods_reference')} / {r.get('rods_new')} | {fmt(r.get('rcurve_l2', math.nan) * 100, '.2f')}% | "
+            f"{r.get('same_rcurve')} | {fmt(r.get('R_mean_baseline'), '.4g')} ({pct(r.get('baseline_R_mean_rel'))}) "
+            f"| {r['verdict']} |")
 
 
 def write_table(rows: list[dict], header: dict, out: pathlib.Path) -> list[pathlib.Path]:
@@ -280,8 +326,8 @@ def write_table(rows: list[dict], header: dict, out: pathlib.Path) -> list[pathl
     return [md, csv_path]
 
 
-def header_of(rows: list[dict], a, base: Variant, new: Variant) -> dict:
-    gs = sorted({r[k] for r in rows for k in ("baseline_G", "new_G") if k in r})
+def header_of(rows: list[dict], a, base: Variant, ref: Variant, new: Variant) -> dict:
+    gs = sorted({r[f"{role}_G"] for r in rows for role in ROLES if f"{role}_G" in r})
     return dict(date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
                 machine=run_bench.machine(), preset=a.preset, G=", ".join(f"{g:g}" for g in gs) or "n/a",
                 jobs=a.jobs, nice=f", nice {a.nice}" if a.nice else "", goal=a.goal,
@@ -289,6 +335,9 @@ def header_of(rows: list[dict], a, base: Variant, new: Variant) -> dict:
                 new=f"{new.binary}" + (f" with {' '.join(a.set)}" if a.set else ""),
                 baseline_git=base.commit, new_git=new.commit,
                 new_sets=f", --set {' '.join(a.set)}" if a.set else " (no --set: its defaults)",
+                reference=("the new run (no lever set)" if ref.same_as else
+                           f"solver {ref.commit}" + (f", --set {' '.join(a.reference_set)}" if a.reference_set
+                                                     else " (no --set: its defaults)")),
                 both_sets=f", both with --set {' '.join(a.set_both)}" if a.set_both else "")
 
 
@@ -304,8 +353,11 @@ def parser() -> argparse.ArgumentParser:
                     help="the new solver (default: ENAMEL_BINARY or build/enamel-dem)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="an override of the new variant only (repeatable): what makes the new default")
+    ap.add_argument("--reference-set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override of the reference only (repeatable): the new solver's levers off, when they are "
+                         "its defaults (default: none, the reference is the new solver at its defaults)")
     ap.add_argument("--set-both", action="append", default=[], metavar="KEY=VALUE",
-                    help="an override of both variants (repeatable; e.g. a smaller specimen for a check)")
+                    help="an override of every variant (repeatable; e.g. a smaller specimen for a check)")
     ap.add_argument("--jobs", type=int, default=2, help="runs at once, one thread each (default 2)")
     ap.add_argument("--nice", type=int, default=0, help="run the solvers at this niceness (default 0: not niced)")
     ap.add_argument("--goal", type=float, default=RATIO_GOAL, help=f"the ratio to reach (default {RATIO_GOAL:g})")
@@ -329,22 +381,20 @@ def main(argv=None) -> int:
               f"converged_cost.py: solver binary {a.binary} not found: run `make build`", file=sys.stderr)
         return 2
     base_binary = a.baseline_binary or baseline_build(a.baseline, a.jobs)
-    base = Variant("baseline", base_binary, a.set_both)
-    new = Variant("new", a.binary, a.set_both + a.set)
+    variants = variants_of(base_binary, a.binary, a.set_both, a.set, a.reference_set)
     if a.fresh:
-        for v in (base, new):
+        for v in variants:
             shutil.rmtree(a.runs / a.preset / v.label, ignore_errors=True)
     if not a.report_only:
         os.environ.update(ONE_THREAD_ENV)   # the solvers inherit it
         try:
-            run_all([base, new], a.cases, a.preset, a.runs, a.jobs, a.nice, a.checkpoint_every)
+            run_all(variants, a.cases, a.preset, a.runs, a.jobs, a.nice, a.checkpoint_every)
         except KeyboardInterrupt as e:
             print(f"converged_cost.py: {e or 'stopped'}", file=sys.stderr)
             return 130
-    rows = [case_row(c, a.runs / a.preset / base.label / c, a.runs / a.preset / new.label / c, a.goal)
-            for c in a.cases]
+    rows = [case_row(c, *(a.runs / a.preset / v.label / c for v in variants), a.goal) for c in a.cases]
     out = a.out or (bench.HERE if a.preset == PRESET else a.runs / a.preset)
-    print(write_table(rows, header_of(rows, a, base, new), out)[0])   # write_csv names the .csv
+    print(write_table(rows, header_of(rows, a, *variants), out)[0])   # write_csv names the .csv
     return 0 if all(r["status"] == "complete" for r in rows) else 1   # the verdicts are in the table
 
 

@@ -1,6 +1,6 @@
 """`make bench-converged`'s script (bench/converged_cost.py): end to end on one small case at the ci preset with the
-current binary as both baseline and new (stopped by SIGINT at a checkpoint, then continued), and its verdict and
-table from crafted numbers. Correctness only: no speed is asserted (the ratio of one binary against itself is
+current binary as both baseline and new (stopped by SIGINT at a checkpoint, then continued; then a lever set on the
+new one, judged against a reference run), and its verdict and table from crafted numbers. Correctness only: no speed is asserted (the ratio of one binary against itself is
 whatever the machine gives)."""
 import csv
 import json
@@ -79,6 +79,25 @@ def test_stopped_continued_and_tabled(enamel, tmp_path):
     again = subprocess.run(harness(enamel, tmp_path), cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert again.returncode == 0 and "complete, not run again" in again.stdout
     assert all(len(pieces(d)) == 2 for d in dirs)   # a finished run is not run again
+    assert row["reference_is_new"] == "True" and "Reference: the new run (no lever set)" in md
+
+    # A "lever" on the new solver only: the reference (the same binary without it) runs once, the baseline is not
+    # run again, and the R-curve is judged against the reference's, which is the first new run bit for bit.
+    lever = subprocess.run(harness(enamel, tmp_path, "--set", "dt_factor=0.15"), cwd=ROOT, env=env,
+                           capture_output=True, text=True, timeout=300)
+    assert lever.returncode == 0, lever.stderr
+    roles = sorted(d.parent.name.split("_")[0] for d in run_dirs(tmp_path))
+    assert roles == ["baseline", "new", "new", "reference"]
+    assert all(len(pieces(d)) == 2 for d in dirs)
+    got = list(csv.DictReader(open(tmp_path / "converged_cost.csv")))[0]
+    assert got["reference_is_new"] == "False" and got["reference_steps"] == row["new_steps"]
+    assert float(got["R_mean_reference"]) == float(row["R_mean_new"])
+    assert float(got["R_mean_baseline"]) == float(row["R_mean_baseline"])
+    assert got["new_steps"] != row["new_steps"]          # dt_factor 0.15 takes more steps than the preset's
+    assert math.isclose(float(got["lever_ratio"]), float(got["reference_core_s"]) / float(got["new_core_s"]),
+                        rel_tol=1e-5)
+    md = (tmp_path / "converged_cost.md").read_text()
+    assert "--set dt_factor=0.15" in md and "Reference: solver" in md
 
 
 @pytest.mark.parametrize("ratio, same, met", [(3.0, True, True), (7.5, True, True), (2.9, True, False),
@@ -96,10 +115,12 @@ def crafted_row(case, b_core, n_core, same):
     ratio = b_core / n_core
     met, words = converged_cost.verdict(ratio, same, why="" if same else "R mean -2.5%")
     row = dict(case=case, status="complete", ratio=ratio, fewer_steps=2.0, cheaper_step=ratio / 2.0, met=met,
-               verdict=words, range_hi=30.2, R_mean_baseline=6.5, R_mean_new=6.5 * (1 if same else 0.975),
-               R_mean_rel=0.0 if same else -0.025, R_init_rel=0.001, rods_baseline=31, rods_new=30, rcurve_l2=0.01,
-               same_rcurve=same)
-    for role, core, steps in (("baseline", b_core, 544364), ("new", n_core, 272182)):
+               verdict=words, range_hi=30.2, R_mean_reference=6.5, R_mean_new=6.5 * (1 if same else 0.975),
+               R_mean_rel=0.0 if same else -0.025, R_init_rel=0.001, rods_reference=31, rods_new=30, rcurve_l2=0.01,
+               same_rcurve=same, lever_ratio=ratio / 1.1, reference_is_new=False, R_mean_baseline=7.1,
+               baseline_R_mean_rel=-0.0845)
+    for role, core, steps in (("baseline", b_core, 544364), ("reference", b_core / 1.1, 544000),
+                              ("new", n_core, 272182)):
         row.update({f"{role}_core_s": core, f"{role}_wall_s": core * 1.01, f"{role}_steps": steps,
                     f"{role}_dof": 222816, f"{role}_pieces": 1, f"{role}_threads": 1, f"{role}_G": 10.0,
                     f"{role}_git": "abc", f"{role}_machines": "AMD EPYC", f"{role}_started_utc": "2026-12-06 07:00"})
@@ -112,13 +133,14 @@ def test_table_from_crafted_numbers(tmp_path):
                                                              verdict=converged_cost.verdict(math.nan, None)[1])]
     header = dict(date="2026-12-06 08:00", machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
                   goal=3.0, baseline="c09beab", new="build/enamel-dem", baseline_git="c09beab539e9",
-                  new_git="abc", new_sets=" (no --set: its defaults)", both_sets="")
+                  new_git="abc", new_sets=" (no --set: its defaults)", both_sets="", reference="solver abc")
     md_path, csv_path = converged_cost.write_table(rows, header, tmp_path)
     md = md_path.read_text()
     lines = {line.split("|")[1].strip(): line for line in md.splitlines() if line.startswith("| ") and "---" not in line}
     assert "| **2.90** |" in lines["a"] and "not met: ratio 2.90 < 3" in lines["a"]
     assert "| **3.44** |" in lines["b"] and "not met: not the same R-curve (R mean -2.5%)" in lines["b"]
-    assert "| **3.20** |" in lines["c"] and lines["c"].rstrip().endswith("| True | met |")
+    assert "| **3.20** |" in lines["c"] and lines["c"].rstrip().endswith("| True | 7.1 (-8.45%) | met |")
+    assert "| 2.64 |" in lines["a"]           # the levers' own ratio, reference / new: (1376 / 1.1) / (1376 / 2.9)
     assert "no comparison" in lines["d"]
     assert "not the converged table" not in md and "G = 10" in md and "c09beab" in md
     got = list(csv.DictReader(open(csv_path)))
