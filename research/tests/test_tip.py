@@ -66,3 +66,17 @@ def test_the_averaged_reading_needs_kinks_first_in_three_of_four_phases():
             recs.append(crafted(s, 10, "intact", ph, 3.0, 6.0, ok))
     avg = next(c for c in tip.candidates(recs) if c["reading"] == "averaged")
     assert avg["converged"] and avg["ii"] and not avg["i"]
+
+
+def test_a_half_rate_twin_is_no_candidate_and_is_judged_against_its_run(tmp_path, monkeypatch):
+    monkeypatch.setattr(tip, "DATA", tmp_path)
+    recs = [crafted(s, 10, "cut", 0, 3.0, 6.0, True) for s in (80, 100)]
+    twin = crafted(80, 10, "cut", 0, 3.0, 6.3, True)          # +5 % over (5,25]: not the same at 2 %
+    twin["keys"]["rate_factor"] = 0.5
+    cands = tip.candidates(recs + [twin])
+    assert len(cands) == 1 and cands[0]["levels"] == (6.0, 6.0)     # the twin is not the 80 d run
+    for i, r in enumerate(recs + [twin]):
+        r["name"] = f"r{i}"
+        (tmp_path / f"r{i}.json").write_text(json.dumps(r))
+    rows = [l for l in tip.twins_report().splitlines() if l.startswith("| r2 ")]
+    assert len(rows) == 1 and "| r0 | 0.5 |" in rows[0] and rows[0].rstrip().endswith("| no |")

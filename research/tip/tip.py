@@ -4,6 +4,8 @@
     python3 -m research.tip.tip record NAME                                            # record a finished run
     python3 -m research.tip.tip report                                                 # the runs table, from data/
     python3 -m research.tip.tip candidates                                             # the rule applied, from data/
+    python3 -m research.tip.tip run NAME ... --rate-factor 0.5                         # a half-rate twin (stage 5)
+    python3 -m research.tip.tip twins                                                  # each twin against its run
 
 A run goes to runs/tip/NAME (niced, one thread, checkpointed); its record to data/NAME.json: the case, the keys of
 the candidate, the metrics the rule reads (R_init, the (0,30] and (5,25] means, the first rod break and the kinks
@@ -35,6 +37,8 @@ PRESET = "converged"
 def solver_args(binary: str, a: argparse.Namespace, out: pathlib.Path) -> list[str]:
     sets = [f"w_s_over_d={a.size}", f"h_s_over_d={a.size}", f"Gamma_k_over_sigma0sq={a.G}",
             f'crisscross_at_tip="{a.reading}"', f"crisscross_phase={a.phase}", "threads=1"]
+    if a.rate_factor != 1.0:
+        sets.append(f"rate_factor={a.rate_factor}")
     args = ["nice", "-n", "19", binary, "run", str(CASE), "--preset", PRESET, "--out", str(out), "--resume",
             "--quiet", "--checkpoint-every", "300"]
     for s in sets:
@@ -103,6 +107,11 @@ PAPER_LEVEL = 7.0
 READING_MARGIN = 0.05             # another reading replaces intact by (iii) only when nearer 7 by more than this
 
 
+def rate_of(rec: dict) -> float:
+    """The run's rate_factor (1: the preset's loading rate; records before stage 5 have no such key)."""
+    return float(rec["keys"].get("rate_factor", 1.0))
+
+
 def curve(rec: dict) -> metrics.RCurve:
     return metrics.RCurve.of(rec["da"], rec["R"], broken_rods=rec["broken_rods"])
 
@@ -110,7 +119,7 @@ def curve(rec: dict) -> metrics.RCurve:
 def members(recs: list[dict], G: float, size: int, reading: str) -> list[dict] | None:
     """The records a candidate reads at one size: its run, or for `averaged` the intact run and the phases."""
     def find(rd, ph):
-        return next((r for r in recs if r["keys"]["size"] == size and r["keys"]["G"] == G
+        return next((r for r in recs if r["keys"]["size"] == size and r["keys"]["G"] == G and rate_of(r) == 1.0
                      and r["keys"]["reading"] == rd and abs(r["keys"]["phase"] - ph) < 1e-9), None)
     got = [find(reading, 0.0)] if reading != "averaged" else [find("intact", ph) for ph in PHASES]
     return None if any(r is None for r in got) else got
@@ -163,6 +172,24 @@ def select(cands: list[dict]) -> tuple[dict | None, str]:
     return best, "none meets (i) and (ii): (iii) alone"
 
 
+def twins_report() -> str:
+    """Each run at another rate_factor against the run of the same keys at the preset's rate, by the measure at
+    the rate-and-speed tolerance (metrics.same_rcurve, TOL_RATE_SPEED: 2 %)."""
+    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    lines = ["| twin | of | rate factor | mean (0,30] rel | R_init rel | rods | L2 | the same R-curve (2 %) |",
+             "|" + "---|" * 8]
+    for t in (r for r in recs if rate_of(r) != 1.0):
+        k = t["keys"]
+        base = members(recs, k["G"], k["size"], k["reading"]) if k["phase"] == 0 else None
+        if not base:
+            lines.append(f"| {t['name']} | none recorded | {rate_of(t):g} | | | | | |")
+            continue
+        c = metrics.same_rcurve(curve(base[0]), curve(t), metrics.TOL_RATE_SPEED)
+        lines.append(f"| {t['name']} | {base[0]['name']} | {rate_of(t):g} | {c.mean_rel:+.2%} | {c.init_rel:+.2%} | "
+                     f"{c.rods_a} / {c.rods_b} | {c.l2:.3f} | {'yes' if c.same else 'no'} |")
+    return "\n".join(lines) + "\n"
+
+
 def candidates_report() -> str:
     recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
     cands = candidates(recs)
@@ -188,14 +215,16 @@ def main(argv=None) -> int:
     run.add_argument("--G", type=float, required=True)
     run.add_argument("--reading", choices=("intact", "cut"), required=True)
     run.add_argument("--phase", type=float, default=0.0)
+    run.add_argument("--rate-factor", type=float, default=1.0, help="rate_factor (0.5: the half-rate twin)")
     run.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     rec = sub.add_parser("record", help="record a finished run of runs/tip/NAME")
     rec.add_argument("name")
     sub.add_parser("report", help="the runs table from data/")
     sub.add_parser("candidates", help="the candidates with both sizes recorded, judged by the rule, from data/")
+    sub.add_parser("twins", help="each run at another rate_factor against its run at the preset's rate")
     a = ap.parse_args(argv)
-    if a.cmd in ("report", "candidates"):
-        print(report() if a.cmd == "report" else candidates_report(), end="")
+    if a.cmd in ("report", "candidates", "twins"):
+        print(dict(report=report, candidates=candidates_report, twins=twins_report)[a.cmd](), end="")
         return 0
     out = RUNS / a.name
     if a.cmd == "record":
@@ -207,7 +236,8 @@ def main(argv=None) -> int:
     if rc != 0:
         print(f"tip: {a.name} exited with status {rc} (log: {out / 'log.txt'})", file=sys.stderr)
         return rc
-    r = record(a.name, out, dict(size=a.size, G=a.G, reading=a.reading, phase=a.phase))
+    keys = dict(size=a.size, G=a.G, reading=a.reading, phase=a.phase)
+    r = record(a.name, out, keys if a.rate_factor == 1.0 else dict(keys, rate_factor=a.rate_factor))
     print(f"{a.name}: {r['statements']}")
     return 0
 
