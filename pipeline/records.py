@@ -57,9 +57,9 @@ def cmd_check(a) -> int:
     return 0
 
 
-def plan_update(a) -> tuple[list, list, list]:
-    """(to write [(result, record, why)], up to date [record], kept [line]) for every completed run of the figure
-    set; exits with one line per malformed record of a run that is there, before anything is written."""
+def plan_update(a) -> tuple[list, list, list, list]:
+    """(to write [(result, record, why)], up to date [record], kept [line], malformed [MalformedRecord]) for every
+    completed run of the figure set."""
     todo, fresh, kept, bad = [], [], [], []
     for case, slow in figure_runs():
         result = paths.result_file(a.preset, case, slow=slow, runs=a.runs)
@@ -82,15 +82,15 @@ def plan_update(a) -> tuple[list, list, list]:
             todo.append((result, record, f"its record is of an older run (written {theirs})"))
         else:
             kept.append(f"records: kept {record}: it is of a newer run (written {theirs}) than {result} ({ours})")
-    if bad:
-        for e in bad:
-            print(f"records: {e}", file=sys.stderr)
-        sys.exit(EXIT_DAMAGED)
-    return todo, fresh, kept
+    return todo, fresh, kept, bad
 
 
 def cmd_update(a) -> int:
-    todo, fresh, kept = plan_update(a)
+    todo, fresh, kept, bad = plan_update(a)
+    if bad:  # one line per malformed record of a run that is there, before anything is written
+        for e in bad:
+            print(f"records: {e}", file=sys.stderr)
+        return EXIT_DAMAGED
     for line in kept:
         print(line, file=sys.stderr)
     for n, (result, record, why) in enumerate(todo, 1):

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT, TINY_SETS, SharedRuns
-from enamel_results import cli, paths, records
+from enamel_results import cli, paths, records, results
 from enamel_results.results import EXIT_DAMAGED, TAG_INTER21, load_result
 from figures import plotting
 from pipeline import records as records_cli
@@ -289,3 +289,52 @@ def test_make_records_and_figures_recorded(enamel, tiny, tmp_path):
     fig5 = next(line for line in lines if line.startswith("figures-recorded: fig5: not made"))
     assert "theta30_s7.1_e10_cv0" in fig5 and "theta30_s21.4_e10_cv0 " not in fig5 + " ", fig5
     assert "figures-recorded: 1 of 7 made" in r.stdout, r.stdout
+
+
+def test_update_rewrites_a_record_of_an_older_run_and_keeps_one_of_a_newer_run(tiny, tmp_path, capsys):
+    runs, recs = tmp_path / "runs", tmp_path / "records"
+    (runs / "ci" / BROKEN).mkdir(parents=True)
+    h5 = runs / "ci" / BROKEN / "result.h5"
+    shutil.copy(tiny / "ci" / BROKEN / "result.h5", h5)
+    update = ["update", "--preset", "ci", "--runs", str(runs), "--records", str(recs)]
+    assert records_cli.main(update) == 0
+    record = paths.record_file("ci", BROKEN, records=recs)
+    first = record.read_bytes()
+    assert records_cli.main(update) == 0 and record.read_bytes() == first
+    assert "0 written, 1 up to date" in capsys.readouterr().out
+    import h5py   # the run again, later: another file, a later written_utc
+    with h5py.File(h5, "r+") as f:
+        f["meta"].attrs["written_utc"] = "2999-01-01T00:00:00Z"
+    results.seal_result_file(h5)
+    assert records_cli.main(update) == 0
+    assert "an older run" in capsys.readouterr().out
+    assert records.record_is_of(records.read_record(record), h5)
+    with h5py.File(h5, "r+") as f:   # the run there is older than the record's
+        f["meta"].attrs["written_utc"] = "2000-01-01T00:00:00Z"
+    results.seal_result_file(h5)
+    before = record.read_bytes()
+    assert records_cli.main(update) == 0
+    err = capsys.readouterr().err
+    assert f"kept {record}" in err and "newer run" in err and record.read_bytes() == before
+    record.write_text("{")   # malformed: refused, nothing written
+    assert records_cli.main(update) == EXIT_DAMAGED
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(record) in err[0] and record.read_text() == "{"
+
+
+def test_a_run_of_a_recorded_preset_leaves_its_record(enamel, tmp_path):
+    """The run rule writes the record of a run of a preset in RECORD_PRESETS (converged and paper by default; here
+    ci, for a tiny run) as it completes, and none for the others (the default make figures is as before)."""
+    runs, recs = tmp_path / "runs", tmp_path / "records"
+    case = "theta30_s21.4_e10_cv0"
+    target = runs / "ci" / case / "result.h5"
+    sets = "w_s_over_d=8 h_s_over_d=4 stop_da_over_d=1.5 frames_da_over_d=[1.5] threads=1"  # no spaces in a value
+    common = [f"RUNS={runs}", f"RECORDS={recs}", f"RUN_SET={sets}", str(target)]
+    r = make(enamel, *common)
+    assert r.returncode == 0 and target.is_file(), r.stdout + r.stderr
+    assert not recs.exists(), "ci is not a recorded preset by default"
+    target.unlink()
+    r = make(enamel, "RECORD_PRESETS=ci", *common)
+    assert r.returncode == 0, r.stdout + r.stderr
+    record = paths.record_file("ci", case, records=recs)
+    assert records.record_is_of(records.read_record(record), target)
