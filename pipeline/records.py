@@ -108,6 +108,20 @@ def available(a, case: str, slow: bool = False) -> bool:
     return paths.find_result(a.preset, case, slow=slow, runs=a.runs, records=a.records).is_file()
 
 
+def solver_commits(a, runs: list[tuple[str, bool]]) -> str:
+    """'c09beab (40), e22f90a (3)': the solver commits of the runs and records there (/meta git_hash)."""
+    count = {}
+    for case, slow in runs:
+        p = paths.find_result(a.preset, case, slow=slow, runs=a.runs, records=a.records)
+        if p.is_file():
+            try:
+                commit = str(records.load(p).meta.get("git_hash", "unknown"))
+            except DamagedResult:
+                continue
+            count[commit] = count.get(commit, 0) + 1
+    return ", ".join(f"{c} ({n})" for c, n in sorted(count.items(), key=lambda kv: -kv[1])) or "none"
+
+
 def cmd_figures(a) -> int:
     figures = cases.figure_list()
     jobs = [(f"figures.{stem}", fig, figures[fig]) for fig, stem in cases.figure_scripts().items()]
@@ -131,7 +145,8 @@ def cmd_figures(a) -> int:
         made += r.returncode == 0
         failed += r.returncode != 0
     print(f"figures-recorded: {made} of {len(jobs)} made in {paths.figure_dir(a.preset, a.out)}/"
-          + (f", {failed} failed" if failed else ""))
+          + (f", {failed} failed" if failed else "") + f"; solver commits of the runs and records: "
+          f"{solver_commits(a, figure_runs())}")
     return 1 if failed else 0
 
 
