@@ -1,5 +1,5 @@
-"""The one place that defines the pipeline's paths: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/,
-and records/<preset>/<case>.json, the small committed record of a finished run (enamel_results/records.py), which
+"""The one place that defines the pipeline's paths: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/.
+records/<preset>/<case>.json is the small committed record of a finished run (enamel_results/records.py), which
 stands for the run when its result file is gone (find_result: the one lookup of a run's result)."""
 import pathlib
 

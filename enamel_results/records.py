@@ -289,9 +289,16 @@ def same_lengths(group: dict, names, where: str) -> None:
 def check_maps(maps: dict) -> None:
     """ValueError naming what in a record's maps is malformed (fields, types, lengths, slice positions)."""
     same_lengths(maps, ("slices", "slice_x"), "maps")
+    if any(len(w) != 4 for w in maps["written_frames"]):
+        raise ValueError("maps.written_frames holds an entry that is not [index, target, Delta_a, step]")
     nslices = len(maps["slices"])
+    tags = sorted(str(t) for t in MAP_TAGS)
+    if sorted(maps["background"]) != tags:
+        raise ValueError(f"maps.background is not of the interface tags {', '.join(tags)}")
     for n, f in enumerate(maps["frames"]):
         check_fields(f, FRAME_SCHEMA, f"maps.frames[{n}].")
+        if sorted(f["interfaces"]) != tags:
+            raise ValueError(f"maps.frames[{n}].interfaces is not of the interface tags {', '.join(tags)}")
         same_lengths(f["broken_rod_elements"], ("ply", "x0", "y0", "x1", "y1"), f"maps.frames[{n}].broken_rod_elements")
         for tag, it in f["interfaces"].items():
             where = f"maps.frames[{n}].interfaces.{tag}."
@@ -331,7 +338,7 @@ def read_record(path) -> dict:
         raise MalformedRecord(path, f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else 'unreadable'}") from e
     try:
         check_record(record)
-    except ValueError as e:
+    except (ValueError, KeyError, TypeError) as e:
         raise MalformedRecord(path, str(e)) from e
     return record
 
@@ -380,6 +387,17 @@ def load_record(path, case: str | None = None, full: bool = False) -> RecordResu
     if not path.is_file():
         raise MissingResult(path)
     rec = read_record(path)
+    try:
+        res = result_of_record(path, rec, case)
+        if full:
+            res.geometry, res.frames = map_geometry(rec["maps"])
+    except (KeyError, ValueError, TypeError, IndexError) as e:
+        raise MalformedRecord(path, f"it cannot be read as a run: {type(e).__name__}: {e}") from e
+    return res
+
+
+def result_of_record(path: pathlib.Path, rec: dict, case: str | None) -> RecordResult:
+    """The RecordResult of a checked record, without its maps."""
     rc, h = from_json(rec["rcurve"]), from_json(rec["history"])
     meta = from_json(rec["meta"])
     case = case or rec["case"]
@@ -391,11 +409,6 @@ def load_record(path, case: str | None = None, full: bool = False) -> RecordResu
                        R_m=float(rc["R_m_over_Gamma"]), dR_m=float(rc["dR_m_over_Gamma"]),
                        da_max=float(rc["da_max_over_d"]), broken_rods=int(h["broken_rod_elements"]),
                        da_first_rod_fracture=float(h["da_first_rod_fracture_over_d"]), written_frames=written)
-    if full:
-        try:
-            res.geometry, res.frames = map_geometry(rec["maps"])
-        except (KeyError, ValueError, TypeError, IndexError) as e:
-            raise MalformedRecord(path, f"its maps cannot be read: {type(e).__name__}: {e}") from e
     return res
 
 

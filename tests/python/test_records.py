@@ -192,8 +192,9 @@ def malformations():
     yield "no R-curve", lambda p: rewrite(p, lambda r: r["rcurve"].pop("R_over_Gamma"))
     yield "R as text", lambda p: rewrite(p, lambda r: r["rcurve"].update(R_over_Gamma="1 2 3"))
     yield "lengths", lambda p: rewrite(p, lambda r: r["rcurve"]["da_over_d"].pop())
-    yield "a map's slice", lambda p: rewrite(p, lambda r: r["maps"]["frames"][0]["interfaces"]["0"]["slice"].__setitem__(
-        0, 10 ** 6))
+    yield "a map's slice", lambda p: rewrite(p, lambda r: r["maps"]["frames"][0]["interfaces"]["0"].update(
+        slice=[10 ** 6] * len(r["maps"]["frames"][0]["interfaces"]["0"]["slice"])))
+    yield "a map's tags", lambda p: rewrite(p, lambda r: r["maps"]["background"].pop("2"))
     yield "no sha", lambda p: rewrite(p, lambda r: None) or p.write_text(p.read_text().replace("content_sha256", "x"))
 
 
