@@ -9,7 +9,7 @@
 update records every completed run of the figure set (runs/P/<run>/result.h5) that has no record in
 records/P/<run>.json, or whose record is of another, older run (its sha256 differs and its /meta written_utc is
 earlier); a record of a newer run than the one there is kept, with a warning. A malformed record of a run that is
-there stops it before anything is written (one line naming it).
+there, or a damaged result file, stops it before anything is written (one line naming each).
 figures makes every figure (and the summary table) whose cases all have a run or a record, from those, running
 nothing, and lists the missing cases of the others (half-rate twins are optional: a figure without them is drawn
 without them, as the figure scripts do).
@@ -24,7 +24,8 @@ import sys
 import time
 
 from enamel_results import cases, paths, records
-from enamel_results.results import EXIT_DAMAGED, EXIT_MISSING, DamagedResult, MissingResult, load_result
+from enamel_results.results import (EXIT_DAMAGED, EXIT_MISSING, DamagedResult, MissingResult, load_result,
+                                    verify_result_file)
 
 
 def figure_runs() -> list[tuple[str, bool]]:
@@ -58,13 +59,18 @@ def cmd_check(a) -> int:
 
 
 def plan_update(a) -> tuple[list, list, list, list]:
-    """(to write [(result, record, why)], up to date [record], kept [line], malformed [MalformedRecord]) for every
-    completed run of the figure set."""
+    """(to write [(result, record, why)], up to date [record], kept [line], bad [a damaged result file's or a
+    malformed record's DamagedResult]) for every completed run of the figure set."""
     todo, fresh, kept, bad = [], [], [], []
     for case, slow in figure_runs():
         result = paths.result_file(a.preset, case, slow=slow, runs=a.runs)
         record = paths.record_file(a.preset, case, slow=slow, records=a.records)
         if not result.is_file():
+            continue
+        try:
+            verify_result_file(result)
+        except DamagedResult as e:
+            bad.append(e)
             continue
         if not record.is_file():
             todo.append((result, record, "no record"))
@@ -87,7 +93,7 @@ def plan_update(a) -> tuple[list, list, list, list]:
 
 def cmd_update(a) -> int:
     todo, fresh, kept, bad = plan_update(a)
-    if bad:  # one line per malformed record of a run that is there, before anything is written
+    if bad:  # one line per damaged result file or malformed record of a run that is there, before anything is written
         for e in bad:
             print(f"records: {e}", file=sys.stderr)
         return EXIT_DAMAGED

@@ -339,3 +339,16 @@ def test_a_run_of_a_recorded_preset_leaves_its_record(enamel, tmp_path):
     assert r.returncode == 0, r.stdout + r.stderr
     record = paths.record_file("ci", case, records=recs)
     assert records.record_is_of(records.read_record(record), target)
+
+
+def test_update_with_a_damaged_result_file_writes_nothing(tiny, tmp_path, capsys):
+    runs, recs = tmp_path / "runs", tmp_path / "records"
+    for case in (FIG4[0], BROKEN):
+        (runs / "ci" / case).mkdir(parents=True)
+        shutil.copy(tiny / "ci" / case / "result.h5", runs / "ci" / case / "result.h5")
+    damaged = runs / "ci" / BROKEN / "result.h5"
+    damaged.write_bytes(damaged.read_bytes()[:-10])
+    assert records_cli.main(["update", "--preset", "ci", "--runs", str(runs), "--records", str(recs)]) == EXIT_DAMAGED
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(damaged) in err[0] and "damaged result" in err[0], err
+    assert not recs.exists(), "nothing written, not even the undamaged run's record"
