@@ -13,12 +13,14 @@ What a record holds (format 1, docs/results.md "Run records"):
     wall_time_s, stop_reason, warnings, case_toml, ...);
   - the R-curve (da, R) at full precision and R_init, R_ss, R_m, dR_m, da_max (/rcurve attributes); the broken
     rod elements at the last /history row and Delta_a/d at the first row with one (nan: none);
-  - the maps of the frames the figures draw (the frame nearest each Delta_a/d of RECORDED_DA, chosen as
-    Result.frame_near chooses): every interface of the map tags (ply 1, ply 2, interlayer 1-2) that is not
-    elastic, at its exact midpoint (x, y), with its state, and every deleted rod element (its two nodes' x, y and
-    the ply of its first node); the /geometry attributes; the slice positions;
-  - the drawing's background: every interface of the map tags, elastic or not, as runs of equally spaced y
-    per slice, to 9 significant digits (within 1e-6 d of the midpoints: the grey dots of the elastic ones);
+  - the maps' interfaces: every interface of the map tags (ply 1, ply 2, interlayer 1-2) at its midpoint, the
+    slice's x (exact) and y as runs of equally spaced values per slice and tag, to 9 significant digits (within
+    BACKGROUND_TOL = 1e-6 d of the file's, checked when written; far below a pixel); the /geometry attributes;
+  - the maps of the frames the figures draw (the frame nearest each Delta_a/d of recorded_da(), chosen as
+    Result.frame_near chooses): each interface's state (elastic, inelastic, failed) as runs over those interfaces
+    in the order of y (a slice with none but elastic ones: []), and every deleted rod element (its two nodes' exact
+    x, y and the ply of its first node); the frame's number, requested and reached Delta_a/d and step, and those of
+    every frame the run wrote;
   - where it came from: the result file's name, size, CRC-32 (its seal) and sha256, and the solver commit;
     and content_sha256, the sha256 of the rest, so that an edited or damaged record is refused.
 Left out: /history (but the two numbers above), every other frame, the interfaces of interlayer 2-1 (drawn in no
@@ -160,42 +162,63 @@ def expand_runs(flat: list) -> np.ndarray:
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
-def background(g: Geometry, pos: np.ndarray, nslices: int) -> dict:
-    """{tag: [per slice: equal_runs of the sorted y of its interfaces]} for the map tags; checks the expansion
-    against the midpoints (BACKGROUND_TOL)."""
+def slice_groups(g: Geometry, pos: np.ndarray, nslices: int) -> dict:
+    """{tag: [per slice position: its interfaces of that tag, in increasing y]} for the map tags."""
     out = {}
     for tag in MAP_TAGS:
-        sel = g.iface_tag == tag
-        per_slice = []
-        for k in range(nslices):
-            y = np.sort(g.iface_midpoint[sel & (pos == k), 1])
-            flat = equal_runs(y)
-            if y.size and np.max(np.abs(expand_runs(flat) - y)) > BACKGROUND_TOL:
-                raise ValueError(f"the background of tag {tag}, slice {k} is not within {BACKGROUND_TOL} d")
-            per_slice.append(flat)
-        out[str(tag)] = per_slice
+        idx = np.flatnonzero(g.iface_tag == tag)
+        idx = idx[np.argsort(g.iface_midpoint[idx, 1], kind="stable")]
+        out[str(tag)] = [idx[pos[idx] == k] for k in range(nslices)]
     return out
 
 
-def frame_map(g: Geometry, f: Frame, pos: np.ndarray) -> dict:
-    """One frame's map: the interfaces of the map tags that are not elastic (slice position, exact y, state) in
-    the file's order, and the deleted rod elements (ply of the first node, both nodes' exact x, y)."""
-    interfaces = {}
-    for tag in MAP_TAGS:
-        m = (g.iface_tag == tag) & (f.iface_state != 0)
-        interfaces[str(tag)] = {"slice": pos[m], "y": g.iface_midpoint[m, 1], "state": f.iface_state[m]}
+def background(g: Geometry, groups: dict) -> dict:
+    """{tag: [per slice: equal_runs of the y of its interfaces]}; checks the expansion against the midpoints
+    (BACKGROUND_TOL)."""
+    out = {}
+    for tag, per_slice in groups.items():
+        out[tag] = []
+        for k, idx in enumerate(per_slice):
+            y = g.iface_midpoint[idx, 1]
+            flat = equal_runs(y)
+            if y.size and np.max(np.abs(expand_runs(flat) - y)) > BACKGROUND_TOL:
+                raise ValueError(f"the background of tag {tag}, slice {k} is not within {BACKGROUND_TOL} d")
+            out[tag].append(flat)
+    return out
+
+
+def state_runs(states: np.ndarray) -> list:
+    """Interface states in the background's order as runs, flat: [state, count, ...]; [] when all are elastic."""
+    if not np.any(states):
+        return []
+    cut = np.flatnonzero(np.diff(states)) + 1
+    starts = np.concatenate(([0], cut))
+    counts = np.diff(np.concatenate((starts, [states.size])))
+    return [int(v) for pair in zip(states[starts], counts) for v in pair]
+
+
+def frame_map(g: Geometry, f: Frame, groups: dict) -> dict:
+    """One frame's map: per map tag and slice, the states of its interfaces in the background's order (equal y:
+    the lower state first) as state_runs; the deleted rod elements (ply of the first node, both nodes' x, y)."""
+    states = {}
+    for tag, per_slice in groups.items():
+        states[tag] = []
+        for idx in per_slice:
+            st, y = f.iface_state[idx], g.iface_midpoint[idx, 1]
+            states[tag].append(state_runs(st[np.lexsort((st, y))]))
     bn = g.beam_nodes[f.beam_broken > 0]
     X = g.node_position
     rods = {"ply": g.node_ply[bn[:, 0]], "x0": X[bn[:, 0], 0], "y0": X[bn[:, 0], 1], "x1": X[bn[:, 1], 0],
             "y1": X[bn[:, 1], 1]}
     return {"index": f.index, "target_da_over_d": f.target_da, "da_over_d": f.da, "step": f.step,
-            "interfaces": interfaces, "broken_rod_elements": rods}
+            "states": states, "broken_rod_elements": rods}
 
 
 def record_of(r: Result, source: dict, frames_da=None) -> dict:
     """The record (without content_sha256) of a Result loaded with full=True from the file `source` describes."""
     g = r.geometry
     numbers, slice_x, pos = slice_positions(g)
+    groups = slice_groups(g, pos, numbers.size)
     chosen = []
     for da in (recorded_da() if frames_da is None else frames_da):
         f = r.frame_near(da)
@@ -205,8 +228,8 @@ def record_of(r: Result, source: dict, frames_da=None) -> dict:
           "R_m_over_Gamma": r.R_m, "dR_m_over_Gamma": r.dR_m, "da_max_over_d": r.da_max}
     maps = {"geometry_attrs": g.attrs, "slices": numbers, "slice_x": slice_x,
             "written_frames": [[f.index, f.target_da, f.da, f.step] for f in r.frames],
-            "frames": [frame_map(g, f, pos) for f in chosen],
-            "background": background(g, pos, numbers.size)}
+            "frames": [frame_map(g, f, groups) for f in chosen],
+            "background": background(g, groups)}
     return to_json({"record": RECORD_KIND, "format": RECORD_FORMAT, "case": r.case,
                     "solver_commit": r.meta.get("git_hash", ""), "source": source, "left_out": LEFT_OUT,
                     "params": r.params, "meta": r.meta, "rcurve": rc,
@@ -242,7 +265,7 @@ SCHEMA = (
     ("maps.written_frames", "[]list"), ("maps.frames", "[]dict"), ("maps.background", dict),
 )
 FRAME_SCHEMA = (("index", int), ("target_da_over_d", "number"), ("da_over_d", "number"), ("step", int),
-                ("interfaces", dict), ("broken_rod_elements.ply", "[]int"), ("broken_rod_elements.x0", "[]number"),
+                ("states", dict), ("broken_rod_elements.ply", "[]int"), ("broken_rod_elements.x0", "[]number"),
                 ("broken_rod_elements.y0", "[]number"), ("broken_rod_elements.x1", "[]number"),
                 ("broken_rod_elements.y1", "[]number"))
 TYPES = {"number": (int, float), "int": int, "list": list, "dict": dict}
@@ -287,29 +310,30 @@ def same_lengths(group: dict, names, where: str) -> None:
 
 
 def check_maps(maps: dict) -> None:
-    """ValueError naming what in a record's maps is malformed (fields, types, lengths, slice positions)."""
+    """ValueError naming what in a record's maps is malformed (fields, types, lengths, tags, the states' counts)."""
     same_lengths(maps, ("slices", "slice_x"), "maps")
     if any(len(w) != 4 for w in maps["written_frames"]):
         raise ValueError("maps.written_frames holds an entry that is not [index, target, Delta_a, step]")
-    nslices = len(maps["slices"])
     tags = sorted(str(t) for t in MAP_TAGS)
-    if sorted(maps["background"]) != tags:
+    counts = {}
+    for tag, per_slice in maps["background"].items():
+        if not isinstance(per_slice, list) or len(per_slice) != len(maps["slices"]) or \
+                any(not isinstance(flat, list) or len(flat) % 3 for flat in per_slice):
+            raise ValueError(f"maps.background.{tag} is not one list of runs per slice")
+        counts[tag] = [sum(flat[2::3]) for flat in per_slice]
+    if sorted(counts) != tags:
         raise ValueError(f"maps.background is not of the interface tags {', '.join(tags)}")
     for n, f in enumerate(maps["frames"]):
         check_fields(f, FRAME_SCHEMA, f"maps.frames[{n}].")
-        if sorted(f["interfaces"]) != tags:
-            raise ValueError(f"maps.frames[{n}].interfaces is not of the interface tags {', '.join(tags)}")
         same_lengths(f["broken_rod_elements"], ("ply", "x0", "y0", "x1", "y1"), f"maps.frames[{n}].broken_rod_elements")
-        for tag, it in f["interfaces"].items():
-            where = f"maps.frames[{n}].interfaces.{tag}."
-            check_fields(it, (("slice", "[]int"), ("y", "[]number"), ("state", "[]int")), where)
-            same_lengths(it, ("slice", "y", "state"), where[:-1])
-            if any(not 0 <= k < nslices for k in it["slice"]):
-                raise ValueError(f"{where}slice holds a position outside maps.slices")
-    for tag, per_slice in maps["background"].items():
-        if not isinstance(per_slice, list) or len(per_slice) != nslices or \
-                any(not isinstance(flat, list) or len(flat) % 3 for flat in per_slice):
-            raise ValueError(f"maps.background.{tag} is not one list of runs per slice")
+        if sorted(f["states"]) != tags:
+            raise ValueError(f"maps.frames[{n}].states is not of the interface tags {', '.join(tags)}")
+        for tag, per_slice in f["states"].items():
+            if not isinstance(per_slice, list) or len(per_slice) != len(counts[tag]) or any(
+                    not isinstance(flat, list) or (flat and sum(flat[1::2]) != c)
+                    for flat, c in zip(per_slice, counts[tag])):
+                raise ValueError(f"maps.frames[{n}].states.{tag} does not give one state to each interface of "
+                                 f"maps.background.{tag}")
 
 
 def check_record(record) -> None:
@@ -412,63 +436,41 @@ def result_of_record(path: pathlib.Path, rec: dict, case: str | None) -> RecordR
     return res
 
 
-def map_points(maps: dict) -> tuple[dict, list]:
-    """The interfaces of the maps: ({(tag, slice position, y): point number} of the exact, not-elastic ones of
-    every recorded frame, the background points [(tag, slice position, y)] that are none of those)."""
-    exact = {}
-    for f in maps["frames"]:
-        for tag, it in f["interfaces"].items():
-            for k, y in zip(it["slice"], it["y"]):
-                exact.setdefault((int(tag), int(k), float(y)), len(exact))
-    rest = []
-    for tag, per_slice in maps["background"].items():
-        near = {}
-        for (t, k, y) in exact:
-            if t == int(tag):
-                near.setdefault(k, []).append(y)
-        for k, flat in enumerate(per_slice):
-            ys = expand_runs(flat)
-            taken = np.asarray(near.get(k, []))
-            if taken.size:
-                ys = ys[np.all(np.abs(ys[:, None] - taken[None, :]) > 10 * BACKGROUND_TOL, axis=1)]
-            rest += [(int(tag), k, float(y)) for y in ys]
-    return exact, rest
-
-
 def map_geometry(maps: dict) -> tuple[Geometry, list[Frame]]:
-    """The Geometry and Frames the process-zone maps need (plotting.draw_process_zone), from a record's maps: the
-    exact not-elastic interfaces of the recorded frames, then the background's (elastic in every recorded frame);
-    the union of the frames' deleted rod elements as two-node elements."""
-    exact, rest = map_points(maps)
-    points = list(exact) + rest
+    """The Geometry and Frames the process-zone maps need (plotting.draw_process_zone), from a record's maps: every
+    interface of the map tags at the background's midpoints, each frame's states from its runs, and the union of the
+    frames' deleted rod elements as two-node elements."""
     slices, slice_x = np.asarray(maps["slices"], dtype=np.int32), np.asarray(maps["slice_x"], dtype=np.float64)
-    k = np.asarray([p[1] for p in points], dtype=np.int64)
-    mid = np.zeros((len(points), 3))
-    mid[:, 0], mid[:, 1] = slice_x[k], [p[2] for p in points]
+    tag, k, y = [], [], []
+    for t, per_slice in maps["background"].items():
+        for n, flat in enumerate(per_slice):
+            ys = expand_runs(flat)
+            tag.append(np.full(ys.size, int(t), dtype=np.int32))
+            k.append(np.full(ys.size, n, dtype=np.int64))
+            y.append(ys)
+    k = np.concatenate(k)
+    mid = np.zeros((k.size, 3))
+    mid[:, 0], mid[:, 1] = slice_x[k], np.concatenate(y)
     rods = {}
     for f in maps["frames"]:
         b = f["broken_rod_elements"]
         for e in zip(b["ply"], b["x0"], b["y0"], b["x1"], b["y1"]):
             rods.setdefault(tuple(e), len(rods))
-    keys = list(rods)
-    X = np.zeros((2 * len(keys), 3))
-    for i, (_, x0, y0, x1, y1) in enumerate(keys):
-        X[2 * i, :2], X[2 * i + 1, :2] = (x0, y0), (x1, y1)
-    geometry = Geometry(node_position=X, node_ply=np.repeat(np.asarray([e[0] for e in keys], dtype=np.int32), 2),
-                        beam_nodes=np.arange(2 * len(keys), dtype=np.int32).reshape(-1, 2), beam_strength=None,
-                        iface_nodes=None, iface_tag=np.asarray([p[0] for p in points], dtype=np.int32),
-                        iface_midpoint=mid, iface_zshift=None, iface_area=None, iface_slice=slices[k],
-                        attrs=from_json(maps["geometry_attrs"]))
+    X = np.zeros((2 * len(rods), 3))
+    X[:, :2] = np.asarray([[x0, y0, x1, y1] for _, x0, y0, x1, y1 in rods], dtype=np.float64).reshape(-1, 2)
+    geometry = Geometry(node_position=X, node_ply=np.repeat(np.asarray([e[0] for e in rods], dtype=np.int32), 2),
+                        beam_nodes=np.arange(2 * len(rods), dtype=np.int32).reshape(-1, 2), beam_strength=None,
+                        iface_nodes=None, iface_tag=np.concatenate(tag), iface_midpoint=mid, iface_zshift=None,
+                        iface_area=None, iface_slice=slices[k], attrs=from_json(maps["geometry_attrs"]))
     frames = []
     for f in maps["frames"]:
-        state = np.zeros(len(points), dtype=np.uint8)
-        for tag, it in f["interfaces"].items():
-            for kk, y, s in zip(it["slice"], it["y"], it["state"]):
-                state[exact[(int(tag), int(kk), float(y))]] = s
-        broken = np.zeros(len(keys), dtype=np.uint8)
+        state = np.concatenate([np.repeat(np.asarray(flat[0::2], dtype=np.uint8), flat[1::2]) if flat else
+                                np.zeros(sum(bg[2::3]), dtype=np.uint8)
+                                for t, per_slice in maps["background"].items()
+                                for flat, bg in zip(f["states"][t], per_slice)])
+        broken = np.zeros(len(rods), dtype=np.uint8)
         b = f["broken_rod_elements"]
-        for e in zip(b["ply"], b["x0"], b["y0"], b["x1"], b["y1"]):
-            broken[rods[tuple(e)]] = 1
+        broken[[rods[e] for e in zip(b["ply"], b["x0"], b["y0"], b["x1"], b["y1"])]] = 1
         frames.append(Frame(index=f["index"], target_da=f["target_da_over_d"], da=f["da_over_d"], step=f["step"],
                             iface_state=state, iface_damage=None, beam_broken=broken, node_displacement=None,
                             beam_stress=None))
