@@ -8,6 +8,8 @@
 #                 table under figures/out/<preset>/ (default PRESET=reduced; JOBS runs at once, default: the
 #                 number of cores). A run that was stopped continues from its checkpoint.
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
+#                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=3"): --set on every run, in a runs
+#                 folder and a figures folder of their own (runs/set_<keys>/, figures/out/set_<keys>/)
 #                 A run with a record (records/<preset>/<case>.json, committed) and no result.h5 is not run again:
 #                 `make figures` draws it from its record. A run of PRESET in RECORD_PRESETS (default: converged
 #                 paper) writes its record as it completes.
@@ -15,8 +17,6 @@
 #                 in records/<preset>/ (commit them: they keep the figures when runs/ is gone; README)
 #   make figures-recorded  [PRESET=...]  every figure (and the summary) whose runs all have a result.h5 or a
 #                 record, from those, running nothing; lists the missing runs of the others
-#                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=3"): --set on every run, in a runs
-#                 folder and a figures folder of their own (runs/set_<keys>/, figures/out/set_<keys>/)
 #   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
 #                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
 #                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
