@@ -222,7 +222,7 @@ def record_of(r: Result, source: dict, frames_da=None) -> dict:
     chosen = []
     for da in (recorded_da() if frames_da is None else frames_da):
         f = r.frame_near(da)
-        if f not in chosen:
+        if all(f.index != c.index for c in chosen):
             chosen.append(f)
     rc = {"da_over_d": r.da, "R_over_Gamma": r.R, "R_init_over_Gamma": r.R_init, "R_ss_over_Gamma": r.R_ss,
           "R_m_over_Gamma": r.R_m, "dR_m_over_Gamma": r.dR_m, "da_max_over_d": r.da_max}

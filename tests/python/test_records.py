@@ -102,6 +102,7 @@ def test_record_loads_as_the_runs_result_exactly(case, tiny, tmp_path):
                                for e in r.geometry.beam_nodes[f.beam_broken > 0])
     assert rods(rec, f_rec) == rods(run, f_run)
     assert not np.any(rec.geometry.iface_tag == TAG_INTER21), "interlayer 2-1 is drawn nowhere: left out"
+    assert {tag for _, tag, _ in plotting.MAP_PANELS} == set(records.MAP_TAGS), "the record holds what the maps draw"
 
 
 def map_pixels(r, da: float = 15) -> np.ndarray:
