@@ -104,8 +104,11 @@ def cmd_update(a) -> int:
         records.write_record(result, record)
         print(f"records: [{n}/{len(todo)}] {record} from {result} ({why}; {kb(record)}, "
               f"{time.monotonic() - t:.1f} s)", flush=True)
-    print(f"records: {len(todo)} written, {len(fresh)} up to date, {len(kept)} kept, in {a.records / a.preset}/ "
-          f"(runs of {a.runs / a.preset}/ without result.h5 are not finished: nothing to record)")
+    runs = figure_runs()
+    done = sum(paths.record_file(a.preset, c, slow=slow, records=a.records).is_file() for c, slow in runs)
+    print(f"records: {len(todo)} written, {len(fresh)} up to date, {len(kept)} kept, in {a.records / a.preset}/: "
+          f"{done} of the figure set's {len(runs)} runs are recorded (a run of {a.runs / a.preset}/ without "
+          f"result.h5 is not finished: nothing to record)")
     return 0
 
 
