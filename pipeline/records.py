@@ -26,12 +26,12 @@ import time
 from enamel_results import cases, paths, records
 from enamel_results.results import (EXIT_DAMAGED, EXIT_MISSING, DamagedResult, MissingResult, load_result,
                                     verify_result_file)
+from pipeline.make_rules import figure_set
 
 
 def figure_runs() -> list[tuple[str, bool]]:
     """Every run of the figure set once: (case, slow), the cases first, then the half-rate twins."""
-    from pipeline.make_rules import figure_set  # the list Make runs
-    _, all_cases, all_slow = figure_set()
+    _, all_cases, all_slow = figure_set()  # the list Make runs
     return [(c, False) for c in all_cases] + [(c, True) for c in all_slow]
 
 
