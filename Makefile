@@ -10,6 +10,13 @@
 #   make runs     [PRESET=...] [JOBS=N]  only the runs: runs/<preset>/<case>/result.h5 (re-runs only what changed)
 #                 Both take RUN_SET="key=value ..." (e.g. "Gamma_k_over_sigma0sq=3"): --set on every run, in a runs
 #                 folder and a figures folder of their own (runs/set_<keys>/, figures/out/set_<keys>/)
+#                 A run with a record (records/<preset>/<case>.json, committed) and no result.h5 is not run again:
+#                 `make figures` draws it from its record. A run of PRESET in RECORD_PRESETS (default: converged
+#                 paper) writes its record as it completes.
+#   make records  [PRESET=...]  a record of every completed run of the figure set that has none or an older one,
+#                 in records/<preset>/ (commit them: they keep the figures when runs/ is gone; README)
+#   make figures-recorded  [PRESET=...]  every figure (and the summary) whose runs all have a result.h5 or a
+#                 record, from those, running nothing; lists the missing runs of the others
 #   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
 #                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
 #                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
@@ -81,10 +88,16 @@ else
 RUNS := runs
 endif
 FIG_ROOT := $(if $(filter runs,$(RUNS)),figures/out,figures/out/$(notdir $(RUNS)))
+# Run records (enamel_results/records.py), committed: records/<preset>/<run>.json, beside each runs folder's
+# figures folder (runs/set_<keys>/ -> records/set_<keys>/); RECORDS= on the command line replaces it.
+ifeq ($(filter command line environment,$(origin RECORDS)),)
+RECORDS := $(if $(filter runs,$(RUNS)),records,records/$(notdir $(RUNS)))
+endif
+RECORD_PRESETS ?= converged paper
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
 .PHONY: bench bench-converged bench-step bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all \
-  vtk reference clean-runs check-preset slurm
+  vtk reference clean-runs check-preset slurm records figures-recorded
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -151,7 +164,14 @@ $(BUILD_DIR)/figures.mk: $(wildcard figures/fig*_*.toml figures/fig*_*.py) pipel
 	$(PYTHON) -m pipeline.make_rules $@
 -include $(BUILD_DIR)/figures.mk
 
-run_targets = $(foreach c,$(1),$(RUNS)/$(PRESET)/$(c)/result.h5) $(foreach c,$(2),$(RUNS)/$(PRESET)/$(c)_slow/result.h5)
+# What a figure reads of one run (enamel_results.paths.find_result, the same rule): its result.h5 when that is there
+# or when it has no record (then Make runs it), else its record, a file no rule makes: a recorded run is not run
+# again (delete its record to run it again).
+run_file = $(RUNS)/$(PRESET)/$(1)/result.h5
+record_file = $(RECORDS)/$(PRESET)/$(1)$(RECORD_SUFFIX)
+source_of = $(if $(or $(wildcard $(call run_file,$(1))),$(if $(wildcard $(call record_file,$(1))),,none)),$\
+  $(call run_file,$(1)),$(call record_file,$(1)))
+run_targets = $(foreach c,$(1),$(call source_of,$(c))) $(foreach c,$(2),$(call source_of,$(c)_slow))
 ALL_RUNS := $(call run_targets,$(ALL_CASES),$(ALL_SLOW))
 
 check-preset:
@@ -179,6 +199,8 @@ define run_case
 	       echo "run: $(@D) stopped (exit $$rc); partial result in $(@D)/result.failed.h5 or result.partial.h5," \
 	            "log in $(@D)/log.txt" >&2; exit $$rc; }
 	@tail -n 2 $(@D)/log.txt
+	$(if $(filter $(PRESET),$(RECORD_PRESETS)),@ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.records write $@ \
+	  $(call record_file,$(notdir $(@D))))
 endef
 
 $(RUNS)/$(PRESET)/%_slow/result.h5: paper_cases/%.toml $(ENAMEL) | check-preset
@@ -205,13 +227,15 @@ FIG_COMMON := figures/plotting.py $(wildcard enamel_results/*.py) figures/paper_
 define figure_rule
 $(FIG_OUT)/$(basename $(notdir $(call fig_script,$(1)))).png: $(call fig_script,$(1)) $(FIG_COMMON) \
     $(call run_targets,$($(shell echo $(1) | tr a-z A-Z)_CASES),$($(shell echo $(1) | tr a-z A-Z)_SLOW))
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m $(call fig_module,$(1)) --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT) \
+	  --records $(RECORDS)
 endef
 $(foreach f,$(FIGURES),$(eval $(call figure_rule,$(f))))
 FIGURE_PNGS := $(foreach f,$(FIGURES),$(FIG_OUT)/$(basename $(notdir $(call fig_script,$(f)))).png)
 
 $(FIG_OUT)/summary.csv: figures/summary_table.py $(FIG_COMMON) $(ALL_RUNS)
-	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m figures.summary_table --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT)
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m figures.summary_table --preset $(PRESET) --runs $(RUNS) --out $(FIG_ROOT) \
+	  --records $(RECORDS)
 
 figures: check-preset
 	$(call parallel,figures)
@@ -219,6 +243,14 @@ figures: check-preset
 figures-all: check-preset $(ENAMEL) $(FIGURE_PNGS) $(FIG_OUT)/summary.csv
 	@test -n "$(FIGURES)" || { echo "figures: no figure list ($(BUILD_DIR)/figures.mk could not be made with PYTHON=$(PYTHON)); run 'make deps' first" >&2; exit 1; }
 	@echo "figures: $(FIG_OUT)/ ($(words $(FIGURE_PNGS)) figures + summary.csv/.md)"
+
+# Records: `make records` records the completed runs; `make figures-recorded` draws what is there, running nothing.
+records: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.records update --preset $(PRESET) --runs $(RUNS) --records $(RECORDS)
+
+figures-recorded: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.records figures --preset $(PRESET) --runs $(RUNS) \
+	  --records $(RECORDS) --out $(FIG_ROOT)
 
 # SLURM: job scripts for the runs of the figure set (pipeline/slurm_jobs.py --help). Every task and the figures
 # job run make with the variables below, never rebuilding the solver (-o): it is built here first.

@@ -1,11 +1,13 @@
 """enamel_results: the Python side's library for enamel-dem's HDF5 results (no plotting).
 
-    paths          the one place that defines the pipeline's paths (paper_cases/, runs/, figures/out/, bench/)
+    paths          the one place that defines the pipeline's paths (paper_cases/, runs/, records/, figures/out/,
+                   bench/) and find_result, the one lookup of a run's result file or record
     cases          the figure tables figures/figN_<name>.toml (which figure uses which case), case-name parameters
     constants      the numbers shared with the solver, read from `enamel-dem constants --json` (exit codes, warning
                    bounds, the result seal, result file names)
     paper_values   figures/paper_values.toml: the numbers the paper states, with their sentences
     results        load one result.h5 (Result, Geometry, Frame), interface tags, EXIT_MISSING
+    records        a run's record (records/<preset>/<run>.json): write one from a result.h5, load one as a Result
     metrics        R-curve comparison and the pooled R_m of Fig. 9
     cli            the figure scripts' shared command line and loading of a figure's runs
 

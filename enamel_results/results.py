@@ -188,10 +188,16 @@ class Result:
 
     def frame_near(self, da: float) -> Frame:
         """The written frame whose requested Delta_a/d is nearest `da` (the final-state frame if none)."""
-        targeted = [f for f in self.frames if f.target_da >= 0]
-        if not targeted:
-            return self.frames[-1]
-        return min(targeted, key=lambda f: (abs(f.target_da - da), -f.target_da))
+        return nearest_frame(self.frames, da)
+
+
+def nearest_frame(frames: list, da: float):
+    """Of frames in the order written (each with .target_da), the one whose requested Delta_a/d is nearest `da`
+    (the larger on a tie); the last (the final state) when none was requested at a Delta_a."""
+    targeted = [f for f in frames if f.target_da >= 0]
+    if not targeted:
+        return frames[-1]
+    return min(targeted, key=lambda f: (abs(f.target_da - da), -f.target_da))
 
 
 def attributes(obj) -> dict:
@@ -263,17 +269,23 @@ def load_result(path, case: str | None = None, full: bool = False) -> Result:
         raise DamagedResult(path, f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else 'unreadable'}") from e
 
 
+def params_of(case: str, meta: dict) -> dict:
+    """The effective case of a run: the parameters in its case name, updated with its /meta case_toml."""
+    params = params_from_name(case)
+    try:
+        params.update(tomllib.loads(meta.get("case_toml", "")))
+    except (tomllib.TOMLDecodeError, TypeError):  # a damaged case_toml: keep the name's parameters
+        pass
+    return params
+
+
 def read_open_result(f, path: pathlib.Path, case: str | None, full: bool) -> Result:
     """The Result of an open result file."""
     meta = attributes(f["meta"])
     rc = attributes(f["rcurve"])
     case = case or meta.get("case_source", path.parent.name)
     case = pathlib.Path(case).stem if case.endswith(".toml") else case
-    params = params_from_name(case)
-    try:
-        params.update(tomllib.loads(meta.get("case_toml", "")))
-    except (tomllib.TOMLDecodeError, TypeError):  # a damaged case_toml: keep the name's parameters
-        pass
+    params = params_of(case, meta)
     h = f["history"]
     broken = h["broken_rod_elements"][:]
     hda = h["da_over_d"][:]

@@ -4,7 +4,8 @@
 One row per theta_D (0, 15, 30 deg): process-zone maps of ply 1, interlayer 1-2 and ply 2 at the frame nearest
 Delta_a/d = 15 (interfaces coloured by state, deleted rod elements in black) and the R-curve R/Gamma_i against
 Delta_a/d, with the half-rate twin where it was run and the paper's stated values (paper_values.toml).
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig4_decussation.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig4_decussation.pdf and .png.
 """
 from figures import plotting
 

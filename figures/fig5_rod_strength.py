@@ -4,7 +4,8 @@
 One row per sigma_ru/sigma0 (7.1, 21.4, 28.5): process-zone maps of ply 1, interlayer 1-2 and ply 2 at the frame
 nearest Delta_a/d = 15 (the paper's, Fig. 5) and the R-curve R/Gamma_i against Delta_a/d, with the half-rate twin
 of sigma_ru/sigma0 = 7.1 where it was run and the paper's stated values (paper_values.toml).
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig5_rod_strength.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig5_rod_strength.pdf and .png.
 """
 from figures import plotting
 

@@ -3,7 +3,8 @@
 
 One row per Er/kd (5, 10, 20): process-zone maps of ply 1, interlayer 1-2 and ply 2 at the frame nearest
 Delta_a/d = 15 and the R-curve R/Gamma_i against Delta_a/d with the paper's stated values (paper_values.toml).
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig6_stiffness_contrast.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig6_stiffness_contrast.pdf and .png.
 """
 from figures import plotting
 

@@ -7,7 +7,8 @@ Rows: R_init, R_ss; columns: Er/kd = 5, 10, 20; horizontal axis sigma_ru/sigma0;
 parameters come from each result's /meta case_toml. R_init is the first R with Delta_a > 0; R_ss is our
 /rcurve attribute (mean R over the last 20% of the advance reached; the paper takes R at Delta_a/d ~ 30).
 Stars: the paper's stated values (paper_values.toml). Red rings: runs that did not complete.
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig7_summary.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig7_summary.pdf and .png.
 """
 import pathlib
 

@@ -5,7 +5,8 @@ theta_D = 30 deg, Er/kd = 10).
 One row per cv (0, 0.1, 0.2, 0.3): process-zone maps of ply 1, interlayer 1-2 and ply 2 of one realisation (the
 lowest seed present) at the frame nearest Delta_a/d = 15, and the R-curves R/Gamma_i against Delta_a/d of all
 realisations (five per cv > 0) with the paper's merged crack resistance R_m/Gamma_i (paper_values.toml).
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig8_statistics_rcurves.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig8_statistics_rcurves.pdf and .png.
 """
 import pathlib
 

@@ -5,7 +5,8 @@
 Left: R_m/Gamma_i, the mean of all R points with 0 < Delta_a/d < 30 pooled over the realisations of one cv (the
 cv = 0 case alone), with the pooled standard deviation Delta R_m/Gamma_i as error bars; small grey dots: each
 realisation's own R_m. Right: Delta R_m/Gamma_i against cv. Dashed: the paper's values (paper_values.toml).
-Reads runs/PRESET/<case>/result.h5; writes figures/out/PRESET/fig9_statistics_mean.pdf and .png.
+Reads runs/PRESET/<case>/result.h5 (or its record records/PRESET/<case>.json);
+writes figures/out/PRESET/fig9_statistics_mean.pdf and .png.
 """
 import pathlib
 

@@ -67,7 +67,9 @@ def draw_process_zone(ax, r: Result, frame: Frame, tag: int, ply: int | None, ti
     by state, and the deleted rod elements of one ply (None: none) as black segments between their nodes."""
     g = r.geometry
     a = g.attrs
-    ws, hs = float(a.get("w_s", g.node_position[:, 0].max())), float(a.get("h_s", g.node_position[:, 1].max()))
+    # the extent of the nodes only where the file has no w_s, h_s (a record's geometry holds few nodes, or none)
+    ws = float(a["w_s"]) if "w_s" in a else float(g.node_position[:, 0].max())
+    hs = float(a["h_s"]) if "h_s" in a else float(g.node_position[:, 1].max())
     sel = g.iface_tag == tag
     mid = g.iface_midpoint[sel]
     state = frame.iface_state[sel]

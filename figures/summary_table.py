@@ -8,7 +8,8 @@ da_max_over_d, R_init_over_Gamma, R_ss_over_Gamma, R_m_over_Gamma, dR_m_over_Gam
 da_first_rod_fracture_over_d, broken_rod_elements (last /history row), wall_time_s, and paper_<quantity> for
 each quantity the paper states for that case (several values joined by ';', a lower bound written '>=X').
 Half-rate twins (a figure table's `slow`) get their own rows where their result file exists.
-Reads runs/PRESET/<case>/result.h5 only.
+Reads runs/PRESET/<case>/result.h5, or where a run's result file is not there its record
+records/PRESET/<case>.json (enamel_results.records; summary.md names both roots).
 """
 import csv
 import math
@@ -152,8 +153,10 @@ def overrides_line(results) -> str:
             item = line[len("# --set "):].strip() if line.startswith("# --set ") else ""
             if item and not item.replace(" ", "").startswith(("threads=", "rate_factor=")):
                 sets.add(item)
-    roots = sorted({str(r.path.parent.parent.parent) for r in results.values()})
-    where = f"Runs: {', '.join(roots)}." if roots else "No runs found."
+    runs = sorted({str(paths.source_root(r.path)) for r in results.values() if not paths.is_record(r.path)})
+    records = sorted({str(paths.source_root(r.path)) for r in results.values() if paths.is_record(r.path)})
+    where = " ".join([f"Runs: {', '.join(runs)}."] * bool(runs) + [f"Records: {', '.join(records)}."] * bool(records))
+    where = where or "No runs found."
     if not sets:
         return where + " Every run at its preset and case file (no --set overrides beyond threads)."
     return (where + " **Every value below is for runs with --set " + " ".join(sorted(sets)) +

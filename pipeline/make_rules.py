@@ -6,7 +6,8 @@
 
 For every figure FIG (fig4 ... fig9, and any figN_<name>.py added with its table): FIG_CASES (its cases) and FIG_SLOW (cases that also run at half the
 preset's loading rate). ALL_CASES and ALL_SLOW are the unique unions: a case shared by several figures runs once.
-The Makefile turns case names into run targets runs/<preset>/<case>[_slow]/result.h5.
+RECORD_SUFFIX: how a run record's name ends (enamel_results.paths). The Makefile turns case names into run targets
+runs/<preset>/<case>[_slow]/result.h5, or records/<preset>/<case>[_slow].json where only the record is there.
 """
 import argparse
 import pathlib
@@ -50,6 +51,7 @@ def main(argv=None):
     lines.append(f"FIGURES := {' '.join(figures)}")
     lines.append(f"ALL_CASES := {' '.join(all_cases)}")
     lines.append(f"ALL_SLOW := {' '.join(all_slow)}")
+    lines.append(f"RECORD_SUFFIX := {paths.RECORD_SUFFIX}")
     pathlib.Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     pathlib.Path(args.out).write_text("\n".join(lines) + "\n")
 
