@@ -52,12 +52,17 @@ STUDY2 = {   # README.md, Study 2, Candidates; the order is its run order
     "margin8_h40_keep": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 40},
     "margin4_h40_keep": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 4, "rate_adapt_horizon": 40},
 }
+STUDY3 = {   # README.md, Study 3
+    "margin8_h20_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 20, "rate_adapt_velocity": QS},
+    "margin16_h20_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 16, "rate_adapt_horizon": 20, "rate_adapt_velocity": QS},
+}
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
 STUDY2_ALL = ("phi1_s2", *STUDY2, "margin8_h10_keep", "margin4_h10_keep", "energy8_keep", "energy4_keep")
 STUDY1 = tuple(CANDIDATES)
 CANDIDATES.update(STUDY2)
+CANDIDATES.update(STUDY3)
 CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
 STATIC_START = {"reduced": 0.95, "ci": 0.0}   # reduced starts as converged does; the ci smoke run as its preset
 
@@ -145,6 +150,7 @@ def rows() -> list[dict]:
     return out
 
 
+STUDY_NAMES = {2: STUDY2_ALL, 3: ("phi1_s2", *STUDY3)}
 CHECK = "check_study2.json"   # data/: whether this build reproduces study 1's records (README.md, Study 2)
 
 
@@ -179,12 +185,13 @@ def study2_record(preset: str, case: str, name: str) -> dict | None:
     return json.loads(old.read_text()) if reuse and name in STUDY1_AS and old.exists() else None
 
 
-def rows2(preset: str = "reduced") -> list[dict]:
-    """Study 2's candidates against its reference (phi1_s2, or study 1's phi1 when the check passed)."""
+def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
+    """Study 2's (or 3's) candidates against study 2's reference (phi1_s2, or study 1's phi1 when the check
+    passed)."""
     out = []
     for case in CASES:
         ref = study2_record(preset, case, "phi1_s2")
-        for name in STUDY2_ALL:
+        for name in names:
             r = study2_record(preset, case, name)
             if r is None:
                 continue
@@ -213,8 +220,8 @@ def decision(rws: list[dict]) -> str:
     return f"{best} goes to the converged check (S1 {ok[best]:.2f}, the smaller of its two cases)"
 
 
-def report2(preset: str = "reduced") -> str:
-    rws = rows2(preset)
+def report2(preset: str = "reduced", names=STUDY2_ALL) -> str:
+    rws = rows2(preset, names)
     lines = ["| case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand | L2 |"
              " same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 12]
     fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
@@ -230,10 +237,11 @@ def report2(preset: str = "reduced") -> str:
     return "\n".join(lines) + "\n\nDecision: " + decision(rws) + "\n"
 
 
-def all2(binary: str, preset: str = "reduced") -> int:
-    """Study 2's runs in the README's order, skipping recorded ones (and study 1's stand-ins when the check passed)."""
+def all2(binary: str, preset: str = "reduced", names=STUDY2_ALL) -> int:
+    """Study 2's (or 3's) runs in the README's order, skipping recorded ones (and study 1's stand-ins when the
+    check passed)."""
     for case in CASES:
-        for name in STUDY2_ALL:
+        for name in names:
             if study2_record(preset, case, name) is not None:
                 continue
             rc = run_one(binary, preset, case, name)
@@ -275,17 +283,17 @@ def main(argv=None) -> int:
     chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
     chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     for p in (every, rep):
-        p.add_argument("--study", type=int, choices=(1, 2), default=1)
+        p.add_argument("--study", type=int, choices=(1, 2, 3), default=1)
     a = ap.parse_args(argv)
     if a.cmd == "report":
-        print(report() if a.study == 1 else report2(), end="")
+        print(report() if a.study == 1 else report2(names=STUDY_NAMES[a.study]), end="")
         return 0
     if a.cmd == "check":
         return 0 if check(a.binary)["reuse_study1"] else 1
     if a.cmd == "run":
         return run_one(a.binary, a.preset, a.case, a.candidate)
-    if a.study == 2:
-        return all2(a.binary, a.preset)
+    if a.study in STUDY_NAMES:
+        return all2(a.binary, a.preset, STUDY_NAMES[a.study])
     for case in CASES:
         for cand in STUDY1:
             rc = run_one(a.binary, a.preset, case, cand)
