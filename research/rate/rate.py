@@ -205,23 +205,33 @@ def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
     return out
 
 
-def decision(rws: list[dict]) -> str:
-    """README.md, Study 2, Decision rule: of the candidates with (S2) on both cases, the largest smaller-of-two
-    (S1); ties to the smaller phi_max, then quasi_static."""
+def best(rws: list[dict], above: float = 0.0) -> tuple[str, float] | None:
+    """README.md, Study 2, Decision rule: of the candidates with (S2) on both cases (and a smaller-of-two (S1) above
+    `above`: study 3's rule), the largest smaller-of-two (S1); ties to the smaller phi_max, then quasi_static."""
     by = {}
     for w in rws:
         by.setdefault(w["candidate"], []).append(w)
     ok = {n: min(x["steps_ratio"] for x in ws) for n, ws in by.items()
           if n != "phi1_s2" and len(ws) == len(CASES) and all(x.get("same") for x in ws)}
+    ok = {n: s for n, s in ok.items() if s > above}
     if not ok:
-        return "none meets (S2) on both cases: none goes to the converged check"
+        return None
     phi_max = lambda n: CANDIDATES[n]["rate_adapt_max"]
-    best = max(ok, key=lambda n: (round(ok[n], 6), -phi_max(n), n.endswith("_qs")))
-    return f"{best} goes to the converged check (S1 {ok[best]:.2f}, the smaller of its two cases)"
+    name = max(ok, key=lambda n: (round(ok[n], 6), -phi_max(n), n.endswith("_qs")))
+    return name, ok[name]
+
+
+def decision(rws: list[dict], above: float = 0.0) -> str:
+    b = best(rws, above)
+    if b is None:
+        return "none meets (S2) on both cases" + (f" with (S1) above {above:.2f}" if above else "") + \
+            ": none goes to the converged check"
+    return f"{b[0]} goes to the converged check (S1 {b[1]:.2f}, the smaller of its two cases)"
 
 
 def report2(preset: str = "reduced", names=STUDY2_ALL) -> str:
     rws = rows2(preset, names)
+    study2 = best(rows2(preset)) if names != STUDY2_ALL else None   # study 3: above study 2's choice
     lines = ["| case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand | L2 |"
              " same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 12]
     fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
@@ -234,7 +244,8 @@ def report2(preset: str = "reduced", names=STUDY2_ALL) -> str:
                      f"{w.get('l2', float('nan')):.3f} | {same} | {fmt(ev['first_rod_break'])}, "
                      f"{fmt(ev['first_interface_failure'])} ({'holds' if w['s3'] else 'fails'}) | "
                      f"{ev['intervals_at_one']}/{ev['intervals']} |")
-    return "\n".join(lines) + "\n\nDecision: " + decision(rws) + "\n"
+    above = f" (study 3's rule: above study 2's {study2[0]}, {study2[1]:.2f})" if study2 else ""
+    return "\n".join(lines) + f"\n\nDecision{above}: " + decision(rws, study2[1] if study2 else 0.0) + "\n"
 
 
 def all2(binary: str, preset: str = "reduced", names=STUDY2_ALL) -> int:
