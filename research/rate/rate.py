@@ -42,20 +42,22 @@ CANDIDATES = {   # README.md, Candidates; the order is the README's
     "energy16": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 16},
 }
 QS = '"quasi_static"'
+
+
+def margin(phi_max: float, horizon: float, velocity: str | None = QS) -> dict:
+    """The keys of a margin-rule candidate (velocity None: the default, keep)."""
+    keys = {"rate_adapt_rule": '"margin"', "rate_adapt_max": phi_max, "rate_adapt_horizon": horizon}
+    return keys if velocity is None else {**keys, "rate_adapt_velocity": velocity}
+
+
 STUDY2 = {   # README.md, Study 2, Candidates; the order is its run order
-    "margin8_h40_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 40, "rate_adapt_velocity": QS},
-    "margin8_h10_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 10, "rate_adapt_velocity": QS},
-    "margin4_h40_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 4, "rate_adapt_horizon": 40, "rate_adapt_velocity": QS},
-    "margin4_h10_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 4, "rate_adapt_horizon": 10, "rate_adapt_velocity": QS},
+    "margin8_h40_qs": margin(8, 40), "margin8_h10_qs": margin(8, 10),
+    "margin4_h40_qs": margin(4, 40), "margin4_h10_qs": margin(4, 10),
     "energy8_qs": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 8, "rate_adapt_velocity": QS},
     "energy4_qs": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 4, "rate_adapt_velocity": QS},
-    "margin8_h40_keep": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 40},
-    "margin4_h40_keep": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 4, "rate_adapt_horizon": 40},
+    "margin8_h40_keep": margin(8, 40, None), "margin4_h40_keep": margin(4, 40, None),
 }
-STUDY3 = {   # README.md, Study 3
-    "margin8_h20_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 8, "rate_adapt_horizon": 20, "rate_adapt_velocity": QS},
-    "margin16_h20_qs": {"rate_adapt_rule": '"margin"', "rate_adapt_max": 16, "rate_adapt_horizon": 20, "rate_adapt_velocity": QS},
-}
+STUDY3 = {"margin8_h20_qs": margin(8, 20), "margin16_h20_qs": margin(16, 20)}   # README.md, Study 3
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
@@ -167,8 +169,9 @@ def check(binary: str, preset: str = "reduced", case: str = CASES[0], names=("ph
             raise SystemExit(f"rate: check run {name} exited with status {rc} (log: {folder / 'log.txt'})")
         new = records.record_of(folder / "result.h5", name)
         old = json.loads((DATA / f"{preset}__{case}__{name}.json").read_text())
-        out["same"][name] = bool(new["meta"]["steps"] == old["meta"]["steps"] and new["da"] == old["da"] and new["R"] == old["R"])
-        print(f"rate: check {name}: steps {new['meta']['steps']} (record {old['meta']['steps']}), same {out['same'][name]}")
+        same = new["meta"]["steps"] == old["meta"]["steps"] and new["da"] == old["da"] and new["R"] == old["R"]
+        out["same"][name] = bool(same)
+        print(f"rate: check {name}: steps {new['meta']['steps']} (record {old['meta']['steps']}), same {same}")
     out["reuse_study1"] = all(out["same"].values())
     DATA.mkdir(exist_ok=True)
     (DATA / CHECK).write_text(json.dumps(out, indent=1))
@@ -200,7 +203,8 @@ def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
             if ref is not None:
                 c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
                 row.update(steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"], mean_rel=c.mean_rel,
-                           init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, comparable=c.comparable, same=c.same)
+                           init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, comparable=c.comparable,
+                           same=c.same)
             out.append(row)
     return out
 
