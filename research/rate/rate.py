@@ -135,8 +135,9 @@ def curve(rec: dict) -> metrics.RCurve:
 
 
 def rows() -> list[dict]:
-    """Each record against the phi1 record of its preset and case: S1, S2 (the measure's numbers), S3."""
-    recs = {p.stem: json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))}
+    """Each study 1 record against the phi1 record of its preset and case: S1, S2 (the measure's numbers), S3."""
+    recs = {p.stem: json.loads(p.read_text()) for p in sorted(DATA.glob("*__*__*.json"))}
+    recs = {name: r for name, r in recs.items() if r["candidate"] in STUDY1}
     out = []
     for name, r in recs.items():
         ref = recs.get(f"{r['preset']}__{r['case']}__phi1")
