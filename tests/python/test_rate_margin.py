@@ -6,7 +6,8 @@ preset's full run, G = 10, so that rods break):
   forecast and the velocity correction leave every dataset of the default run as it is, bit for bit, and add no
   dataset (the forecast is kept in the solver's state, not in /history);
 - the controller's own check: with rate_adapt_max = 8 the first interface failure falls in a history interval
-  with phi = 1 at both ends, the rate rose above 4 before it, and the run completes in under half the steps;
+  with phi = 1 at both ends, the rate rose above 4 before it, and the run completes in under half the steps (the
+  first rod break does not: a strict expected failure, docs/solver.md);
 - with the correction on, every history interval's energy balance stays as closed as without it (the
   correction's kinetic energy is booked to the external work);
 - a margin run with the correction, killed (SIGKILL) twice and continued with --restart, is the uninterrupted
@@ -79,6 +80,15 @@ def test_rate_is_one_at_the_first_interface_failure(margin8, default_run):
     assert phi[:i].max() > 4, "the rate never rose before the first failure"
     assert phi[i - 1] == 1.0 and phi[i] == 1.0
     assert h["step"][-1] < 0.5 * default_run["history/step"][-1]
+
+
+@pytest.mark.xfail(strict=True, reason="measured 2026-12-06 (AMD EPYC): the first rod break of this run falls in an "
+                   "interval from phi 1.25 to 1: the rod's forecast read 3-16 rows over 7 rows at phi 1, then 54 "
+                   "rows on the row before the break, and phi rose x1.25 (docs/solver.md, Adaptive loading rate)")
+def test_rate_is_one_at_the_first_rod_break(margin8):
+    h = history(margin8)
+    phi, i = h["rate_multiplier"], first_event_rows(h)["rod"]
+    assert phi[i - 1] == 1.0 and phi[i] == 1.0, f"phi {phi[i - 1]} -> {phi[i]} over the first rod break"
 
 
 def test_correction_keeps_the_balance_and_changes_the_run(margin8, margin8_quasi_static):
