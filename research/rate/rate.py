@@ -1,8 +1,10 @@
-"""The margin-rule study (README.md here): its runs, their records and the report.
+"""The margin-rule study and the velocity-correction study (README.md here): runs, records and reports.
 
     python3 -m research.rate.rate run --preset reduced --case theta30_s21.4_e10_cv0 --candidate margin8
     python3 -m research.rate.rate all --preset reduced      # every case and candidate in the README's order
     python3 -m research.rate.rate report                    # the table, from data/
+    python3 -m research.rate.rate check                     # study 2: this build against study 1's records
+    python3 -m research.rate.rate all --study 2             # study 2's runs; report --study 2: its table
 
 A run goes to runs/rate/PRESET/CASE/CANDIDATE (niced, one thread, checkpointed, --resume); its record to
 data/PRESET__CASE__CANDIDATE.json: the keys, steps, the solver's wall and core seconds, the machine, phi at the
@@ -39,11 +41,37 @@ CANDIDATES = {   # README.md, Candidates; the order is the README's
     "energy4": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 4},
     "energy16": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 16},
 }
-STATIC_START = {"reduced": 0.95, "ci": 0.0}   # reduced starts as converged does; the ci smoke run as its preset
+QS = '"quasi_static"'
+
+
+def margin(phi_max: float, horizon: float, velocity: str | None = QS) -> dict:
+    """The keys of a margin-rule candidate (velocity None: the default, keep)."""
+    keys = {"rate_adapt_rule": '"margin"', "rate_adapt_max": phi_max, "rate_adapt_horizon": horizon}
+    return keys if velocity is None else {**keys, "rate_adapt_velocity": velocity}
+
+
+STUDY2 = {   # README.md, Study 2, Candidates; the order is its run order
+    "margin8_h40_qs": margin(8, 40), "margin8_h10_qs": margin(8, 10),
+    "margin4_h40_qs": margin(4, 40), "margin4_h10_qs": margin(4, 10),
+    "energy8_qs": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 8, "rate_adapt_velocity": QS},
+    "energy4_qs": {"rate_adapt_rule": '"energy"', "rate_adapt_max": 4, "rate_adapt_velocity": QS},
+    "margin8_h40_keep": margin(8, 40, None), "margin4_h40_keep": margin(4, 40, None),
+}
+STUDY3 = {"margin8_h20_qs": margin(8, 20), "margin16_h20_qs": margin(16, 20)}   # README.md, Study 3
+# study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
+STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
+             "energy8_keep": "energy8", "energy4_keep": "energy4"}
+STUDY2_ALL = ("phi1_s2", *STUDY2, "margin8_h10_keep", "margin4_h10_keep", "energy8_keep", "energy4_keep")
+STUDY1 = tuple(CANDIDATES)
+CANDIDATES.update(STUDY2)
+CANDIDATES.update(STUDY3)
+CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
+# reduced starts as converged does (its preset's own 0.95); the ci smoke run as its preset
+STATIC_START = {"reduced": 0.95, "converged": 0.95, "ci": 0.0}
 
 
 def solver_args(binary: str, case: str, preset: str, candidate: str, out: pathlib.Path) -> list[str]:
-    sets = {"threads": 1, "static_start": STATIC_START.get(preset, 0.0), **CANDIDATES[candidate]}
+    sets = {"threads": 1, "static_start": STATIC_START[preset], **CANDIDATES[candidate]}
     args = ["nice", "-n", "5", binary, "run", str(paths.case_file(case)), "--preset", preset, "--out", str(out),
             "--resume", "--quiet", "--checkpoint-every", "120"]
     for k, v in sets.items():
@@ -108,8 +136,9 @@ def curve(rec: dict) -> metrics.RCurve:
 
 
 def rows() -> list[dict]:
-    """Each record against the phi1 record of its preset and case: S1, S2 (the measure's numbers), S3."""
-    recs = {p.stem: json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))}
+    """Each study 1 record against the phi1 record of its preset and case: S1, S2 (the measure's numbers), S3."""
+    recs = {p.stem: json.loads(p.read_text()) for p in sorted(DATA.glob("*__*__*.json"))}
+    recs = {name: r for name, r in recs.items() if r["candidate"] in STUDY1}
     out = []
     for name, r in recs.items():
         ref = recs.get(f"{r['preset']}__{r['case']}__phi1")
@@ -123,6 +152,119 @@ def rows() -> list[dict]:
                        comparable=c.comparable, same=c.same)
         out.append(row)
     return out
+
+
+STUDY_NAMES = {2: STUDY2_ALL, 3: ("phi1_s2", *STUDY3)}
+CHECK = "check_study2.json"   # data/: whether this build reproduces study 1's records (README.md, Study 2)
+
+
+def check(binary: str, preset: str = "reduced", case: str = CASES[0], names=("phi1", "margin8")) -> dict:
+    """Run study 1's `names` of `case` again with this build (into runs/rate/check/) and compare steps and every
+    R-curve point (10 digits) with their records; writes data/check_study2.json and returns it."""
+    out = {"binary": binary, "case": case, "preset": preset, "recorded": time.strftime("%Y-%m-%d"), "same": {}}
+    for name in names:
+        folder = RUNS / "check" / preset / case / name
+        folder.mkdir(parents=True, exist_ok=True)
+        with open(folder / "log.txt", "a") as log:
+            rc = subprocess.run(solver_args(binary, case, preset, name, folder), stderr=log).returncode
+        if rc != 0:
+            raise SystemExit(f"rate: check run {name} exited with status {rc} (log: {folder / 'log.txt'})")
+        new = records.record_of(folder / "result.h5", name)
+        old = json.loads((DATA / f"{preset}__{case}__{name}.json").read_text())
+        same = new["meta"]["steps"] == old["meta"]["steps"] and new["da"] == old["da"] and new["R"] == old["R"]
+        out["same"][name] = bool(same)
+        print(f"rate: check {name}: steps {new['meta']['steps']} (record {old['meta']['steps']}), same {same}")
+    out["reuse_study1"] = all(out["same"].values())
+    DATA.mkdir(exist_ok=True)
+    (DATA / CHECK).write_text(json.dumps(out, indent=1))
+    return out
+
+
+def study2_record(preset: str, case: str, name: str) -> dict | None:
+    """Study 2's record of a candidate: its own, else (when the check passed) study 1's of the same keys."""
+    own = DATA / f"{preset}__{case}__{name}.json"
+    if own.exists():
+        return json.loads(own.read_text())
+    reuse = (DATA / CHECK).exists() and json.loads((DATA / CHECK).read_text())["reuse_study1"]
+    old = DATA / f"{preset}__{case}__{STUDY1_AS.get(name, '')}.json"
+    return json.loads(old.read_text()) if reuse and name in STUDY1_AS and old.exists() else None
+
+
+def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
+    """Study 2's (or 3's) candidates against study 2's reference (phi1_s2, or study 1's phi1 when the check
+    passed)."""
+    out = []
+    for case in CASES:
+        ref = study2_record(preset, case, "phi1_s2")
+        for name in names:
+            r = study2_record(preset, case, name)
+            if r is None:
+                continue
+            row = dict(preset=preset, case=case, candidate=name, steps=r["meta"]["steps"], core_s=r["core_seconds"],
+                       s3=s3_holds(r["events"]), events=r["events"])
+            if ref is not None:
+                c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
+                row.update(steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"], mean_rel=c.mean_rel,
+                           init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, comparable=c.comparable,
+                           same=c.same)
+            out.append(row)
+    return out
+
+
+def best(rws: list[dict], above: float = 0.0) -> tuple[str, float] | None:
+    """README.md, Study 2, Decision rule: of the candidates with (S2) on both cases (and a smaller-of-two (S1) above
+    `above`: study 3's rule), the largest smaller-of-two (S1); ties to the smaller phi_max, then quasi_static."""
+    by = {}
+    for w in rws:
+        by.setdefault(w["candidate"], []).append(w)
+    ok = {n: min(x["steps_ratio"] for x in ws) for n, ws in by.items()
+          if n != "phi1_s2" and len(ws) == len(CASES) and all(x.get("same") for x in ws)}
+    ok = {n: s for n, s in ok.items() if s > above}
+    if not ok:
+        return None
+    phi_max = lambda n: CANDIDATES[n]["rate_adapt_max"]
+    name = max(ok, key=lambda n: (round(ok[n], 6), -phi_max(n), n.endswith("_qs")))
+    return name, ok[name]
+
+
+def decision(rws: list[dict], above: float = 0.0) -> str:
+    b = best(rws, above)
+    if b is None:
+        return "none meets (S2) on both cases" + (f" with (S1) above {above:.2f}" if above else "") + \
+            ": none goes to the converged check"
+    return f"{b[0]} goes to the converged check (S1 {b[1]:.2f}, the smaller of its two cases)"
+
+
+def report2(preset: str = "reduced", names=STUDY2_ALL) -> str:
+    rws = rows2(preset, names)
+    study2 = best(rows2(preset)) if names != STUDY2_ALL else None   # study 3: above study 2's choice
+    lines = ["| case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand | L2 |"
+             " same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 12]
+    fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
+    for w in rws:
+        ev = w["events"]
+        same = "yes" if w.get("same") else ("no" if w.get("comparable") else "not comparable")
+        lines.append(f"| {w['case'].split('_')[0]} | {w['candidate']} | {w['steps']} | {w.get('steps_ratio', float('nan')):.2f} | "
+                     f"{w['core_s'] or float('nan'):.0f} | {100 * w.get('mean_rel', float('nan')):+.2f} % | "
+                     f"{100 * w.get('init_rel', float('nan')):+.2f} % | {'/'.join(map(str, w.get('rods', ('-', '-'))))} | "
+                     f"{w.get('l2', float('nan')):.3f} | {same} | {fmt(ev['first_rod_break'])}, "
+                     f"{fmt(ev['first_interface_failure'])} ({'holds' if w['s3'] else 'fails'}) | "
+                     f"{ev['intervals_at_one']}/{ev['intervals']} |")
+    above = f" (study 3's rule: above study 2's {study2[0]}, {study2[1]:.2f})" if study2 else ""
+    return "\n".join(lines) + f"\n\nDecision{above}: " + decision(rws, study2[1] if study2 else 0.0) + "\n"
+
+
+def all2(binary: str, preset: str = "reduced", names=STUDY2_ALL) -> int:
+    """Study 2's (or 3's) runs in the README's order, skipping recorded ones (and study 1's stand-ins when the
+    check passed)."""
+    for case in CASES:
+        for name in names:
+            if study2_record(preset, case, name) is not None:
+                continue
+            rc = run_one(binary, preset, case, name)
+            if rc != 0:
+                return rc
+    return 0
 
 
 def report() -> str:
@@ -154,15 +296,23 @@ def main(argv=None) -> int:
     every.add_argument("--preset", default="reduced")
     for p in (one, every):
         p.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
-    sub.add_parser("report", help="the table from data/")
+    rep = sub.add_parser("report", help="the table from data/")
+    chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
+    chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
+    for p in (every, rep):
+        p.add_argument("--study", type=int, choices=(1, 2, 3), default=1)
     a = ap.parse_args(argv)
     if a.cmd == "report":
-        print(report(), end="")
+        print(report() if a.study == 1 else report2(names=STUDY_NAMES[a.study]), end="")
         return 0
+    if a.cmd == "check":
+        return 0 if check(a.binary)["reuse_study1"] else 1
     if a.cmd == "run":
         return run_one(a.binary, a.preset, a.case, a.candidate)
+    if a.study in STUDY_NAMES:
+        return all2(a.binary, a.preset, STUDY_NAMES[a.study])
     for case in CASES:
-        for cand in CANDIDATES:
+        for cand in STUDY1:
             rc = run_one(a.binary, a.preset, case, cand)
             if rc != 0:
                 return rc

@@ -35,3 +35,17 @@ def test_two_candidates_record_and_report(enamel, tmp_path, monkeypatch):
     before = log.stat().st_mtime_ns
     assert rate.run_one(str(enamel), "ci", case, "margin8") == 0
     assert log.stat().st_mtime_ns == before
+
+
+def test_study2_decision_takes_the_largest_smaller_saving_of_those_same_on_both_cases():
+    """README.md, Study 2, Decision rule, on rows of two cases: a candidate the same on one case only does not go,
+    whatever its saving; of those the same on both, the largest smaller-of-two steps ratio; a tie goes to the
+    smaller phi_max."""
+    def rows(name, ratios, same):
+        return [dict(candidate=name, case=c, steps_ratio=r, same=s) for c, r, s in zip(rate.CASES, ratios, same)]
+    rws = (rows("margin8_h10_qs", (3.0, 2.5), (True, False)) + rows("margin8_h40_qs", (1.8, 2.2), (True, True))
+           + rows("margin4_h40_qs", (2.0, 1.7), (True, True)))
+    assert rate.decision(rws).startswith("margin8_h40_qs goes")       # min 1.8 against margin4's 1.7
+    tie = rows("margin8_h40_qs", (1.8, 2.2), (True, True)) + rows("margin4_h40_qs", (1.8, 1.9), (True, True))
+    assert rate.decision(tie).startswith("margin4_h40_qs goes")       # the same 1.8: the smaller phi_max
+    assert rate.decision(rows("margin8_h10_qs", (3.0, 2.5), (True, False))).startswith("none meets")

@@ -136,6 +136,21 @@ enum class Need { required, optional };
       "element was deleted and no more interfaces failed than 4 x the pre-cracked interfaces of one slice, else "   \
       "held; phi "                                                                                                  \
       "ramps linearly to its new value over the next history interval")                                            \
+    X(rate_adapt_rule, Choice, numerics, optional, RateAdaptRule::energy, "[]", 0, 0, "-",                         \
+      "adaptive loading rate's rule (rate_adapt_max > 1): energy = the rule of rate_adapt_max alone; margin = the " \
+      "smaller of that and a forecast's phi: each rod element's stress / strength and each interface's effective " \
+      "separation / delta_f extrapolated from its rise since the last history row give the rows at v_app until "  \
+      "the first rod break or interface failure, and phi = those rows / "                                          \
+      "rate_adapt_horizon within [1, rate_adapt_max]: the rate is 1 over the last rows before a forecast event"    \
+      " (docs/solver.md)")                                                                                         \
+    X(rate_adapt_horizon, Real, numerics, optional, 10, "[]", 1, 1e4, "history rows at phi = 1",                   \
+      "adaptive loading rate, margin rule: phi is the forecast rows to the next failure event / this (within "    \
+      "[1, rate_adapt_max]), so the rate falls to 1 as the event comes within this many rows of loading at v_app") \
+    X(rate_adapt_velocity, Choice, numerics, optional, RateAdaptVelocity::keep, "[]", 0, 0, "-",                   \
+      "adaptive loading rate's velocity at a change of phi: keep = the free nodes keep their velocity (the "       \
+      "interior follows the grips' new rate by waves); quasi_static = each time step over which phi changes adds " \
+      "(phi_{n+1} - phi_n) U'(tau)/U(tau) q to the free nodes' velocity (the quasi-static motion of proportional " \
+      "loading changed with the rate), its kinetic energy booked to the external work (docs/solver.md)")          \
     X(ramp_transits, Real, numerics, optional, 1, "[]", 0, 1e3, "h_s/c_d",                                          \
       "velocity ramp: duration of the smooth ramp from rest, in transit times h_s/c_d")                             \
     X(static_start, Real, numerics, optional, 0, "[)", 0, 1, "-",                                                   \

@@ -16,7 +16,7 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 10;  // 2: the header carries the build fingerprint; 3: State holds vHalf
+constexpr std::uint32_t kVersion = 11;  // 2: the header carries the build fingerprint; 3: State holds vHalf
                                        // and the reactions, frames the rod stress; 4: the loading clock and
                                        // the record's static elastic start; 5: history rows hold the kinetic
                                        // energy beyond the loading's motion; 6: ... and the inelastic zone's
@@ -24,7 +24,8 @@ constexpr std::uint32_t kVersion = 10;  // 2: the header carries the build finge
                                        // records whether the model held a mechanism; 8: the record its
                                        // far-field rod break warning; 9: a CRC-32 of every byte before it;
                                        // 10: State's interface dissipation account (empty at beta = 1)
-                                       // ends the file (before the trailing magic)
+                                       // ends the file (before the trailing magic); 11: the margin rule's
+                                       // progress and forecast (State::lastProgress, lastForecast) after it
 // The file: magic, version, build, case, fields (transferFields), CRC-32 of all that (4 bytes), magic.
 constexpr std::size_t kTrailerBytes = sizeof(std::uint32_t) + sizeof kMagic;
 
@@ -130,6 +131,9 @@ void transferFields(Io& io, S& s, R& rec) {
   io.items(rec.warnings, [&](auto& w) { io.str(w); });
   io.pod(rec.staticStart);
   io.vec(s.lambdaMaxBooked); io.vec(s.ifaceDissipation);
+  io.pod(s.lastProgress.loadingTime); io.vec(s.lastProgress.rods); io.vec(s.lastProgress.interfaces);
+  io.pod(s.lastForecast.rowsToRodBreak); io.pod(s.lastForecast.rowsToInterfaceFailure);
+  io.pod(s.lastForecast.rowsElapsed);
 }
 
 // The effective case's keys that can change a result, without its comment lines (the source file as given, the

@@ -38,6 +38,10 @@ class Integrator {
   /// grips): what is left of the velocity when the quasi-static motion q' = (U'/U) q of a linear specimen is
   /// taken out (the adaptive loading rate's measure, loading_rate.hpp).
   virtual double kineticEnergyBeyond(const Operators& ops, const State& s, double rate) const = 0;
+  /// Add c q to the free DOFs' velocity (the scheme's: v, or vHalf for a half-step scheme) and return the
+  /// kinetic energy this adds, 1/2 (v + dv)^T M (v + dv) - 1/2 v^T M v with this scheme's mass (the adaptive
+  /// rate's velocity correction, loading_rate.hpp quasiStaticVelocityFactor).
+  virtual double addToFreeVelocities(const Operators& ops, State& s, double c) const = 0;
   /// Whether the scheme's mass is the consistent one (ops.M); false for lumped-mass schemes.
   virtual bool usesConsistentMass() const { return true; }
   /// Whether the scheme's velocity is the half-step one (State::vHalf) rather than v_n (State::v).

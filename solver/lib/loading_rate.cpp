@@ -1,7 +1,9 @@
 #include "loading_rate.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
+#include <vector>
 
 namespace enamel {
 
@@ -15,6 +17,59 @@ double nextRateMultiplier(double phi, double phiMax, const RateControlInput& in)
   if (rho > kRateRhoHigh) return std::max(1.0, kRateLower * phi);
   if (rho < kRateRhoLow && !burst) return std::min(phiMax, kRateRaise * phi);
   return phi;
+}
+
+// (1 - now) dtau / (now - before) while rising; 0 at or past 1; NaN comparisons are false: +inf.
+double timeToEvent(double before, double now, double dtau) {
+  if (now >= 1.0) return 0.0;
+  if (!(now > before) || !(dtau > 0)) return INFINITY;
+  return (1.0 - now) * dtau / (now - before);
+}
+
+namespace {
+// The earliest timeToEvent over one kind of element, in rows; NaN when `before` is not a measurement of them.
+double earliestRows(const std::vector<double>& before, const std::vector<double>& now, double dtau, double rowTime) {
+  if (before.size() != now.size() || std::isnan(dtau)) return NAN;
+  double earliest = INFINITY;
+  for (std::size_t i = 0; i < now.size(); ++i) earliest = std::min(earliest, timeToEvent(before[i], now[i], dtau));
+  return earliest / rowTime;
+}
+}  // namespace
+
+EventForecast forecastEvents(const EventProgress& before, const EventProgress& now, double rowTime) {
+  const double dtau = now.loadingTime - before.loadingTime;
+  return EventForecast{earliestRows(before.rods, now.rods, dtau, rowTime),
+                       earliestRows(before.interfaces, now.interfaces, dtau, rowTime), dtau / rowTime};
+}
+
+// fell by more than the loading covered: rowsNow rowsElapsed / fall (< rowsNow); else rowsNow
+double trendedRows(double rowsBefore, double rowsNow, double rowsElapsed, double within) {
+  const double fall = rowsBefore - rowsNow;
+  if (!(rowsNow < within)) return rowsNow;
+  if (!std::isfinite(fall) || !std::isfinite(rowsElapsed) || !(fall > rowsElapsed)) return rowsNow;
+  return rowsNow * rowsElapsed / fall;
+}
+
+double rowsToFirstEvent(const EventForecast& last, const EventForecast& now, double within) {
+  if (std::isnan(now.rowsToRodBreak) || std::isnan(now.rowsToInterfaceFailure)) return NAN;
+  return std::min(trendedRows(last.rowsToRodBreak, now.rowsToRodBreak, now.rowsElapsed, within),
+                  trendedRows(last.rowsToInterfaceFailure, now.rowsToInterfaceFailure, now.rowsElapsed, within));
+}
+
+// rows / horizon within [1, phiMax]; NaN (no forecast): 1
+double marginRateTarget(double rowsToEvent, double horizon, double phiMax) {
+  if (std::isnan(rowsToEvent)) return 1.0;
+  return std::clamp(rowsToEvent / horizon, 1.0, std::max(1.0, phiMax));
+}
+
+double nextRateMultiplierByMargin(double phi, double phiMax, double horizon, const RateControlInput& in) {
+  return std::max(1.0, std::min(nextRateMultiplier(phi, phiMax, in), marginRateTarget(in.rowsToEvent, horizon, phiMax)));
+}
+
+// c = (phi' - phi) U'/U; 0 without a change or a proportional motion
+double quasiStaticVelocityFactor(double phiBefore, double phiAfter, double velocity, double displacement) {
+  if (phiAfter == phiBefore || !(displacement > 0)) return 0.0;
+  return (phiAfter - phiBefore) * velocity / displacement;
 }
 
 int burstInterfacesOf(const Model& m) {

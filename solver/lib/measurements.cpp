@@ -87,6 +87,24 @@ double inelasticReach(const Model& m, const cohesive::Law& law, const State& s) 
   return std::max(inelasticInterfaceReach(m, law, s), brokenRodReach(m, s));
 }
 
+EventProgress measureEventProgress(const Model& m, const Materials& mat, const State& s) {
+  EventProgress p;
+  p.loadingTime = s.loadingTime;
+  if (mat.rodsBreakable) {
+    computeStressRatiosForBeams(m, mat, s.q, s.beamBroken, p.rods);
+    for (int e = 0; e < m.numBeams(); ++e)
+      if (s.beamBroken[e]) p.rods[e] = NAN;
+  }
+  const cohesive::Law& law = mat.law;
+  const double deltaf = law.deltaf();
+  p.interfaces.resize(m.numInterfaces());
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < m.numInterfaces(); ++i)
+    p.interfaces[i] = cohesive::isFailed(law, s.lambdaMax[i])
+        ? NAN : cohesive::effectiveSeparation(law, computeLocalOpening(m, s.q, i)) / deltaf;
+  return p;
+}
+
 // The slope is stored per DOF (set with the grips, setup.cpp prescribeGrips): a test of the shape value's
 // sign would take a bottom node at x = w_s, whose shape is -0.0, for a top node.
 double sumGripForceTimesSlope(const Model& m, const Operators& ops, const State& s) {

@@ -30,6 +30,13 @@ double inelasticInterfaceReach(const Model& m, const cohesive::Law& law, const S
 double brokenRodReach(const Model& m, const State& s);
 double inelasticReach(const Model& m, const cohesive::Law& law, const State& s);
 
+/// Each element's progress toward its failure event (EventProgress, state.hpp; the adaptive rate's margin
+/// rule): a rod element's stress / strength as the deletion check computes it (computeStressRatiosForBeams; no
+/// rods when they do not break), an interface's effective separation / delta_f (cohesive::effectiveSeparation
+/// of the law at its present opening: what lambdaMax must reach for it to fail); NaN once deleted or failed.
+/// The loading clock is s.loadingTime.
+EventProgress measureEventProgress(const Model& m, const Materials& mat, const State& s);
+
 /// The loaded faces' term of J before the 1/B: sum over the prescribed DOFs of F_y du_y/dx, with F_y the
 /// force the grip applies and du_y/dx = ops.prescribedSlope x U / w_s (-U/w_s on the top row, +U/w_s on the
 /// bottom row, also at x = w_s where the shape value is +/-0).

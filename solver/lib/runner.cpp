@@ -376,11 +376,16 @@ class RunLoop {
                                 r.inelasticInterfaces));
   }
 
-  /// The adaptive loading rate (loading_rate.hpp), at each history row when rate_adapt_max > 1: the rule
-  /// nextRateMultiplier on the interval since the previous row (energies at its end, rods deleted and interfaces
+  /// The adaptive loading rate (loading_rate.hpp), at each history row: with rate_adapt_rule = margin the
+  /// forecast of the next failure event first (forecastEvents, kept in State; also when rate_adapt_max = 1,
+  /// where it sets nothing); then, when rate_adapt_max > 1, the rule (nextRateMultiplier, or nextRateMultiplierByMargin
+  /// with the forecast) on the interval since the previous row (energies at its end, rods deleted and interfaces
   /// failed during it) sets phi's next target, reached linearly over the next history interval.
   void controlLoadingRate() {
     const auto& h = rec_.history;
+    const bool margin = p_.rate_adapt_rule == RateAdaptRule::margin;
+    double rowsToEvent = NAN;
+    if (margin) rowsToEvent = forecastNextEvent();
     if (!sim_.materials.loading.adaptive() || h.size() < 2) return;
     const Measurement& now = h.back();
     const Measurement& before = h[h.size() - 2];
@@ -390,8 +395,24 @@ class RunLoop {
     in.rodsDeleted = now.brokenBeams - before.brokenBeams;
     in.interfacesFailed = now.failedInterfaces - before.failedInterfaces;
     in.burstInterfaces = burstInterfaces_;
+    in.rowsToEvent = rowsToEvent;
     State& s = sim_.state;
-    setRateMultiplierTarget(s, nextRateMultiplier(s.rateMultiplier, p_.rate_adapt_max, in), historyEvery_);
+    const double phi = margin ? nextRateMultiplierByMargin(s.rateMultiplier, p_.rate_adapt_max, p_.rate_adapt_horizon, in)
+                              : nextRateMultiplier(s.rateMultiplier, p_.rate_adapt_max, in);
+    setRateMultiplierTarget(s, phi, historyEvery_);
+  }
+
+  /// The margin rule's forecast at this row (forecastEvents: each element's progress now against the last
+  /// row's, rows of historyEvery_ steps at phi = 1); the progress and the forecast kept in State for the next
+  /// row; returns the rows the rule reads (rowsToFirstEvent, with the last row's forecast).
+  double forecastNextEvent() {
+    State& s = sim_.state;
+    EventProgress now = measureEventProgress(sim_.model, sim_.materials, s);
+    const EventForecast f = forecastEvents(s.lastProgress, now, historyEvery_ * sim_.integrator->timeStep());
+    s.lastProgress = std::move(now);
+    const EventForecast last = s.lastForecast;
+    s.lastForecast = f;
+    return rowsToFirstEvent(last, f, p_.rate_adapt_horizon * p_.rate_adapt_max);
   }
 
   /// A progress line on stderr every 2 s: step, load, crack, R, this piece's steps/s and the time left.

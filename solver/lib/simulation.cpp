@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "loading_rate.hpp"
 #include "measurements.hpp"
 #include "setup.hpp"
 #include "static_solve.hpp"
@@ -90,12 +91,23 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   return st;
 }
 
+/// rate_adapt_velocity = quasi_static: phi went from phiBefore to phi_{n+1} over the step just taken, so the free
+/// nodes' velocity gets (phi_{n+1} - phiBefore) U'(tau_{n+1})/U q_{n+1} (quasiStaticVelocityFactor), and the
+/// kinetic energy this adds is booked to the external work (the loading's impulse: the balance stays closed).
+void Simulation::followRateChange(double phiBefore) {
+  const double c = quasiStaticVelocityFactor(phiBefore, state.rateMultiplier, materials.loading.velocity(state.loadingTime),
+                                             state.appliedDisplacement);
+  if (c != 0.0) state.externalWork += integrator->addToFreeVelocities(ops, state, c);
+}
+
 /// One time step: the scheme's step; book the interfaces' dissipation; check the rods' stresses and delete the
 /// overloaded ones; measure the crack when something broke. Each lap books the calls before it to their phase.
 void Simulation::step() {
   PhaseLaps laps(timers_);
   const int failedBefore = state.failedInterfaces;
+  const double phiBefore = state.rateMultiplier;
   integrator->advance(model, materials, ops, state);
+  if (params.rate_adapt_velocity == RateAdaptVelocity::quasi_static) followRateChange(phiBefore);
   laps.lap(StepPhase::Advance);
   bookInterfaceDissipation(model, materials.law, state);
   laps.lap(StepPhase::InterfaceDissipation);

@@ -107,6 +107,7 @@ class Simulation {
   const StressCheckSchedule& stressCheckSchedule() const { return stressSchedule_; }
 
  private:
+  void followRateChange(double phiBefore);  // rate_adapt_velocity = quasi_static (simulation.cpp)
   std::vector<double> beamStressRatio_;  // scratch: sigma / sigma_ru per rod element
   StressCheckSchedule stressSchedule_;   // scratch: which rod elements the deletion check computes
   StepTimers* timers_ = nullptr;         // setTimers

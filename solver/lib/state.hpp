@@ -6,6 +6,7 @@
 //   State      everything a time step changes; with the case, all that a checkpoint holds
 // A scheme's own data (lumped mass, dt, its factorisation) lives in the scheme (integrators.hpp).
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -104,6 +105,24 @@ struct Operators {
   int maxNodesPerSlice = 0;
 };
 
+/// The adaptive rate's margin rule (loading_rate.hpp; case key rate_adapt_rule = margin): each element's
+/// progress toward its failure event at one history row, and the loading clock tau then. A rod element's is its
+/// stress / strength (the deletion check's ratio: deleted at 1), an interface's its effective separation /
+/// delta_f (failed at 1); NaN once the element is deleted or failed. Empty (and tau NaN) until measured.
+struct EventProgress {
+  double loadingTime = NAN;
+  std::vector<double> rods, interfaces;
+};
+
+/// The margin rule's forecast at one history row, in history rows at phi = 1 (loading_rate.hpp
+/// forecastEvents): the rows until the first rod break and the first interface failure (+inf: no element's
+/// progress rose; NaN: not forecast), and the loading the last interval covered in rows. Kept in State for the
+/// next row's trend (not a history column: a run with the rule off writes main's history, bit for bit).
+struct EventForecast {
+  double rowsToRodBreak = NAN, rowsToInterfaceFailure = NAN;
+  double rowsElapsed = NAN;  // the last interval's loading time / rowTime (its mean phi)
+};
+
 /// Everything that changes during a run (checkpointable: checkpoint.cpp lists every field once).
 struct State {
   long step = 0;
@@ -133,6 +152,8 @@ struct State {
   double lastExternalPower = 0;        // grip power where the last interval of externalWork ended
   int failedInterfaces = 0;            // at the last update of the interface history
   double crackAdvance = 0;             // Delta a (d)
+  EventProgress lastProgress;          // the margin rule's progress at the last history row (empty otherwise)
+  EventForecast lastForecast;          // ... and its forecast there (NaN otherwise)
 
   int brokenBeams() const { return static_cast<int>(deletionOrder.size()); }
 };

@@ -3,7 +3,9 @@
 // leaves [1, rate_adapt_max]; the loading clock ramps phi linearly to its target and integrates tau exactly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "loading_rate.hpp"
 
@@ -86,5 +88,145 @@ TEST(LoadingRate, ClockRampsPhiLinearlyAndIntegratesTau) {
     advanceLoadingClock(off, 0.3, t);
     EXPECT_EQ(t.loadingTime, t.time);
     EXPECT_EQ(t.rateMultiplier, 1.0);
+  }
+}
+
+// --- the margin rule (rate_adapt_rule = margin): its forecast and its rule, without a mesh ---
+
+TEST(LoadingRateMargin, TimeToEventExtrapolatesTheLastRise) {
+  EXPECT_DOUBLE_EQ(timeToEvent(0.5, 0.6, 2.0), 8.0);   // 0.4 left at 0.05 per unit of loading time
+  EXPECT_EQ(timeToEvent(0.9, 1.0, 2.0), 0.0);          // at its event
+  EXPECT_EQ(timeToEvent(0.5, 1.2, 2.0), 0.0);          // past it (a rod the deletion rule has not taken yet)
+  EXPECT_EQ(timeToEvent(0.6, 0.6, 2.0), INFINITY);     // not rising
+  EXPECT_EQ(timeToEvent(0.7, 0.6, 2.0), INFINITY);     // unloading
+  EXPECT_EQ(timeToEvent(NAN, 0.6, 2.0), INFINITY);     // failed before, or never measured
+  EXPECT_EQ(timeToEvent(0.5, NAN, 2.0), INFINITY);     // failed now
+}
+
+TEST(LoadingRateMargin, ForecastIsTheEarliestElementInRows) {
+  EventProgress before{1.0, {0.2, 0.5, NAN}, {0.1, 0.30}};
+  EventProgress now{3.0, {0.3, 0.5, NAN}, {0.1, 0.35}};
+  const EventForecast f = forecastEvents(before, now, 0.5);  // rows of 0.5 loading time: dtau is 4 rows
+  EXPECT_DOUBLE_EQ(f.rowsElapsed, 4.0);
+  EXPECT_DOUBLE_EQ(f.rowsToRodBreak, 0.7 * 2.0 / 0.1 / 0.5);          // rod 0: 14 time units, 28 rows
+  EXPECT_DOUBLE_EQ(f.rowsToInterfaceFailure, 0.65 * 2.0 / 0.05 / 0.5);  // interface 1: 52 rows
+  EXPECT_DOUBLE_EQ(rowsToFirstEvent(EventForecast{}, f, 1e9), 28.0);  // no last forecast: no trend
+  // nothing rising: +inf; no measurement before (the first row, or another size): NaN, and the rule's rows NaN
+  EXPECT_EQ(forecastEvents(now, now, 0.5).rowsToRodBreak, INFINITY);
+  const EventForecast first = forecastEvents(EventProgress{}, now, 0.5);
+  EXPECT_TRUE(std::isnan(first.rowsToRodBreak) && std::isnan(first.rowsToInterfaceFailure));
+  EXPECT_TRUE(std::isnan(rowsToFirstEvent(EventForecast{}, first, 1e9)));
+  // rods that do not break: no rod vectors at either row, the interfaces alone decide
+  EventProgress b2{1.0, {}, {0.1, 0.30}}, n2{3.0, {}, {0.1, 0.35}};
+  EXPECT_DOUBLE_EQ(rowsToFirstEvent(EventForecast{}, forecastEvents(b2, n2, 0.5), 1e9), 52.0);
+}
+
+TEST(LoadingRateMargin, TrendTakesAnAcceleratingForecastWithinReach) {
+  EXPECT_DOUBLE_EQ(trendedRows(100.0, 92.0, 8.0, 1e9), 92.0);       // fell by the loading covered: exact
+  EXPECT_DOUBLE_EQ(trendedRows(100.0, 95.0, 8.0, 1e9), 95.0);       // fell less: as is
+  EXPECT_DOUBLE_EQ(trendedRows(100.0, 40.0, 8.0, 1e9), 40.0 * 8.0 / 60.0);  // fell 60 in 8: ~5.3 rows
+  EXPECT_DOUBLE_EQ(trendedRows(100.0, 40.0, 8.0, 40.0), 40.0);      // not within reach: as is
+  EXPECT_DOUBLE_EQ(trendedRows(INFINITY, 40.0, 8.0, 1e9), 40.0);    // a new element rising: as is
+  EXPECT_EQ(trendedRows(40.0, INFINITY, 8.0, 1e9), INFINITY);
+  EXPECT_TRUE(std::isnan(trendedRows(40.0, NAN, 8.0, 1e9)));
+  EXPECT_DOUBLE_EQ(trendedRows(NAN, 40.0, 8.0, 1e9), 40.0);
+}
+
+TEST(LoadingRateMargin, TargetIsRowsOverHorizonWithinOneAndTheMaximum) {
+  EXPECT_DOUBLE_EQ(marginRateTarget(1000.0, 10.0, 8.0), 8.0);  // far from an event: the maximum
+  EXPECT_DOUBLE_EQ(marginRateTarget(INFINITY, 10.0, 8.0), 8.0);
+  EXPECT_DOUBLE_EQ(marginRateTarget(40.0, 10.0, 8.0), 4.0);
+  EXPECT_DOUBLE_EQ(marginRateTarget(9.0, 10.0, 8.0), 1.0);     // within the horizon: 1
+  EXPECT_DOUBLE_EQ(marginRateTarget(NAN, 10.0, 8.0), 1.0);     // no forecast: 1
+  EXPECT_DOUBLE_EQ(marginRateTarget(1000.0, 10.0, 1.0), 1.0);  // off
+}
+
+TEST(LoadingRateMargin, RaisesFarFromAnEventAsTheEnergyRuleAllows) {
+  RateControlInput in = interval(1e-4);
+  in.rowsToEvent = 1e6;
+  double phi = 1;
+  for (int k = 0; k < 12; ++k) phi = nextRateMultiplierByMargin(phi, 8.0, 10.0, in);
+  EXPECT_DOUBLE_EQ(phi, 8.0);  // x1.25 a row up to the maximum
+  // the energy rule still halves on a deletion or high kinetic ratio, and holds on a burst, far from an event
+  RateControlInput deleted = interval(1e-4, 1);
+  deleted.rowsToEvent = 1e6;
+  EXPECT_DOUBLE_EQ(nextRateMultiplierByMargin(8.0, 8.0, 10.0, deleted), 4.0);
+  RateControlInput burst = interval(1e-4, 0, 9);
+  burst.rowsToEvent = 1e6;
+  EXPECT_DOUBLE_EQ(nextRateMultiplierByMargin(5.0, 8.0, 10.0, burst), 5.0);
+}
+
+TEST(LoadingRateMargin, ApproachingAnEventTheRateIsOneOverTheLastHorizon) {
+  // An event 2000 rows of loading at v_app ahead, forecast exactly: each row the loading covers the mean phi
+  // of its ramp. phi rises to the maximum, falls as rows / horizon, is set to 1 on every row within the
+  // horizon and is 1 there from the second of them on (on the first it ends its ramp from just above 1).
+  for (double phiMax : {4.0, 8.0, 16.0}) {
+    const double horizon = 10.0;
+    double rows = 2000.0, phi = 1.0;
+    int steps = 0, rowsWithin = 0;
+    double peak = 1;
+    while (rows > 0) {
+      RateControlInput in = interval(1e-4);
+      in.rowsToEvent = rows;
+      const double next = nextRateMultiplierByMargin(phi, phiMax, horizon, in);
+      if (rows <= horizon) {
+        EXPECT_EQ(next, 1.0) << "phi_max " << phiMax << ", " << rows << " rows before the event";
+        if (rowsWithin > 0) EXPECT_EQ(phi, 1.0) << "phi_max " << phiMax << ", " << rows << " rows before the event";
+        EXPECT_LT(phi, 1.0 + 1.0 / horizon + 1e-12);
+        ++rowsWithin;
+      }
+      rows -= 0.5 * (phi + next);
+      phi = next;
+      peak = std::max(peak, phi);
+      ++steps;
+    }
+    EXPECT_EQ(peak, phiMax);
+    EXPECT_GE(rowsWithin, 9);                          // the last horizon at phi = 1
+    EXPECT_LT(steps, 2000 / phiMax + 12 * horizon);    // far fewer rows than 2000
+  }
+}
+
+TEST(LoadingRateMargin, ARodNearItsStrengthHoldsTheRateAtOne) {
+  // a rod element at 0.999 of its strength, rising by 0.001 per row: one row from breaking
+  EventProgress before{0.0, {0.998, 0.5}, {0.2}}, now{1.0, {0.999, 0.5}, {0.2}};
+  const EventForecast f = forecastEvents(before, now, 1.0);
+  EXPECT_NEAR(f.rowsToRodBreak, 1.0, 1e-9);
+  RateControlInput in = interval(1e-4);
+  in.rowsToEvent = rowsToFirstEvent(EventForecast{}, f, 80.0);
+  EXPECT_EQ(nextRateMultiplierByMargin(1.0, 8.0, 10.0, in), 1.0);
+  EXPECT_EQ(nextRateMultiplierByMargin(6.0, 8.0, 10.0, in), 1.0);  // from a high rate: down to 1 at once
+  // a rod past its strength (not deleted yet) is 0 rows away whatever its rise
+  EventProgress past{1.0, {1.0001, 0.5}, {0.2}};
+  EXPECT_EQ(forecastEvents(now, past, 1.0).rowsToRodBreak, 0.0);
+}
+
+// --- the velocity correction at a change of phi (rate_adapt_velocity = quasi_static), without a mesh ---
+
+TEST(LoadingRateVelocity, FactorIsTheChangeOfTheQuasiStaticRate) {
+  EXPECT_DOUBLE_EQ(quasiStaticVelocityFactor(1.0, 1.5, 0.2, 4.0), 0.5 * 0.2 / 4.0);   // raised: the interior speeds up
+  EXPECT_DOUBLE_EQ(quasiStaticVelocityFactor(2.0, 1.0, 0.2, 4.0), -1.0 * 0.2 / 4.0);  // lowered: it slows down
+  EXPECT_EQ(quasiStaticVelocityFactor(2.0, 2.0, 0.2, 4.0), 0.0);                      // held: nothing
+  EXPECT_EQ(quasiStaticVelocityFactor(1.0, 2.0, 0.2, 0.0), 0.0);                      // U = 0: no motion to follow
+  EXPECT_EQ(quasiStaticVelocityFactor(1.0, 2.0, 0.2, -1.0), 0.0);
+  EXPECT_EQ(quasiStaticVelocityFactor(1.0, 2.0, 0.2, NAN), 0.0);
+}
+
+TEST(LoadingRateVelocity, ARampOfTheClockMovesTheQuasiStaticVelocityWithPhi) {
+  // One DOF at q = 3 moving with the loading, v = phi (U'/U) q, U'/U = 0.05 held: the clock ramps phi from 1 to 6
+  // over 7 steps and back to 2 over 5; the factors of each step, added as c q, keep v = phi (U'/U) q at every step.
+  const double rate = 0.05, q = 3.0;
+  State s;
+  double v = s.rateMultiplier * rate * q;
+  Loading on;
+  on.rateAdaptMax = 8;
+  for (auto [target, steps] : {std::pair{6.0, 7L}, std::pair{2.0, 5L}}) {
+    setRateMultiplierTarget(s, target, steps);
+    for (long k = 0; k < steps; ++k) {
+      const double before = s.rateMultiplier;
+      advanceLoadingClock(on, 0.1, s);
+      v += quasiStaticVelocityFactor(before, s.rateMultiplier, rate, 1.0) * q;
+      EXPECT_NEAR(v, s.rateMultiplier * rate * q, 1e-14) << "target " << target << ", step " << k;
+    }
+    EXPECT_EQ(s.rateMultiplier, target);
   }
 }

@@ -1,6 +1,7 @@
 """Multithreading: the force loops run in parallel with OpenMP, and a run with
 2 threads gives the same result as with 1 thread, bit for bit: R-curve, the whole /history (energies,
-J, counts) and the final damage state. Both integrators; a small case in which rods and interfaces break."""
+J, counts) and the final damage state. Both integrators, and the lumped one with the adaptive rate's margin rule
+and velocity correction; a small case in which rods and interfaces break."""
 import h5py
 import numpy as np
 import pytest
@@ -10,6 +11,9 @@ from conftest import ROOT
 CASE = ROOT / "paper_cases" / "theta30_s7.1_e10_cv0.toml"
 SETS = {"lumped": ["w_s_over_d=12", "h_s_over_d=6", "stop_da_over_d=3"],
         "paper": ["w_s_over_d=8", "h_s_over_d=4", "stop_da_over_d=1.5", 'integrator="paper"']}
+# the adaptive rate's margin rule (its forecast's pass over the elements runs in parallel) and velocity correction
+SETS["lumped_margin_quasi_static"] = SETS["lumped"] + ['rate_adapt_rule="margin"', "rate_adapt_max=8",
+                                                       'rate_adapt_velocity="quasi_static"']
 
 
 def result_arrays(path):
@@ -28,8 +32,8 @@ def result_arrays(path):
     return out, status
 
 
-@pytest.mark.parametrize("integrator", ["lumped", "paper"])
-def test_two_threads_give_the_one_thread_result(integrator, run, tmp_path, monkeypatch):
+@pytest.mark.parametrize("variant", sorted(SETS))
+def test_two_threads_give_the_one_thread_result(variant, run, tmp_path, monkeypatch):
     # Threads that sleep at barriers instead of spinning: on a machine whose cores are busy with other work (a
     # loaded CI runner, a parallel build) spinning threads made the 2-thread paper run take > 600 s; this test
     # is about the result, not the speed.
@@ -38,7 +42,7 @@ def test_two_threads_give_the_one_thread_result(integrator, run, tmp_path, monke
     for threads in (1, 2):
         out = tmp_path / f"t{threads}"
         args = ["run", CASE, "--preset", "ci", "--out", out, "--quiet", "--set", f"threads={threads}"]
-        for s in SETS[integrator]:
+        for s in SETS[variant]:
             args += ["--set", s]
         r = run(*args)
         assert r.returncode == 0, r.stderr

@@ -220,6 +220,15 @@ class LumpedIntegrator : public Integrator {
     const VecX w = s.vHalf - rate * s.q;
     return 0.5 * w.dot(mass_.cwiseProduct(w));
   }
+  double addToFreeVelocities(const Operators& ops, State& s, double c) const override {
+    double added = 0;
+    for (int dof : ops.freeDofs) {
+      const double dv = c * s.q[dof];
+      added += mass_[dof] * dv * (s.vHalf[dof] + 0.5 * dv);
+      s.vHalf[dof] += dv;
+    }
+    return added;
+  }
 
  private:
   // Forces, then velocities, slice by slice in one pass over the model (its slices in parallel; within a

@@ -100,6 +100,14 @@ class PaperIntegrator : public Integrator {
     const VecX w = s.v - rate * s.q;
     return 0.5 * w.dot(ops.M * w);
   }
+  double addToFreeVelocities(const Operators& ops, State& s, double c) const override {
+    VecX dv = VecX::Zero(s.v.size());
+    for (int dof : ops.freeDofs) dv[dof] = c * s.q[dof];
+    const VecX Mdv = ops.M * dv;
+    const double added = Mdv.dot(s.v) + 0.5 * Mdv.dot(dv);
+    s.v += dv;
+    return added;
+  }
 
  private:
   // w = v_n + dt/2 a_n
