@@ -67,9 +67,9 @@ enum class Need { required, optional };
     X(cv, Real, physics, optional, 0, "[)", 0, 1, "-",                                                              \
       "strength scatter: coefficient of variation of rod-element strength (normal distribution, "                   \
       "negative draws redrawn)")                                                                                    \
-    X(Gamma_k_over_sigma0sq, Real, physics, optional, 10, "[]", 1, 1e4, "sigma0^2/k",                               \
+    X(Gamma_k_over_sigma0sq, Real, physics, optional, 9, "[]", 1, 1e4, "sigma0^2/k",                                \
       "interface fracture energy: Gamma_i k / sigma0^2 (>= 1 for a trapezoid law; sets the "                        \
-      "fracture length; 10 = identified on size-converged specimens, docs/model.md)")                             \
+      "fracture length; 9 = identified with the cut tip reading on size-converged specimens, docs/model.md)")     \
     X(softening_over_delta0, Real, physics, optional, 1, "(]", 0, 2e4, "delta0",                                   \
       "interface softening length: (delta_f - delta1)/delta0, the length of the trapezoid's linear drop at "      \
       "fixed Gamma_i (plateau end delta1 = Gamma_i/sigma0 + (delta0 - L)/2); 1 = the symmetric trapezoid, "        \
@@ -116,7 +116,7 @@ enum class Need { required, optional };
     X(h_e_over_d, Real, numerics, optional, 0.3, "(]", 0, 1, "d",                                                   \
       "slice spacing: distance h_e between discrete yz layers (paper: 0.3 coarse, 0.15 fine; "                      \
       "h_e larger than d is an error)")                                                                             \
-    X(crisscross_at_tip, Choice, numerics, optional, CrisscrossAtTip::intact, "[]", 0, 0, "-",                    \
+    X(crisscross_at_tip, Choice, numerics, optional, CrisscrossAtTip::cut, "[]", 0, 0, "-",                       \
       "crisscross at the tip: the origin of the crisscross lattice, intact = a crisscross point at the pre-crack "  \
       "tip a0_eff = (K + 1/4) h_e, its rods intact (in element [K, K+1]); cut = at a0_eff - h_e/2, its rods cut "   \
       "by the pre-crack (paper Fig. 4: the first intact crisscross ~d/sin(theta_D) ahead) (docs/model.md)")        \

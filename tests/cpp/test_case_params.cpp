@@ -84,7 +84,8 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.Er_over_kd, 10.0);
     EXPECT_EQ(p.sigma_ru_over_sigma0, 21.4);
     EXPECT_EQ(p.cv, 0.0);
-    EXPECT_EQ(p.Gamma_k_over_sigma0sq, 10.0);
+    EXPECT_EQ(p.Gamma_k_over_sigma0sq, 9.0);
+    EXPECT_EQ(p.crisscross_at_tip, CrisscrossAtTip::cut);
     EXPECT_EQ(p.section, SectionShape::hexagon);
     EXPECT_EQ(p.seed, 1);
     EXPECT_TRUE(p.rods_breakable);
@@ -509,9 +510,9 @@ TEST(CaseParams, SetValuesThatTomlCannotHoldAreRefusedOrEscaped) {
 // it is a cross-key check, still one line naming the key, the value and the allowed range.
 TEST(CaseParams, SofteningOverDelta0RangeDependsOnGamma) {
     EXPECT_EQ(parse("").softening_over_delta0, 1.0);
-    EXPECT_EQ(parse("softening_over_delta0 = 19\n").softening_over_delta0, 19.0);  // the triangle at G = 10
+    EXPECT_EQ(parse("Gamma_k_over_sigma0sq = 10\nsoftening_over_delta0 = 19\n").softening_over_delta0, 19.0);  // the triangle
     EXPECT_EQ(parse("softening_over_delta0 = 5\nGamma_k_over_sigma0sq = 3\n").softening_over_delta0, 5.0);
-    const auto high = caseErrorOf([] { parse("", "", {"softening_over_delta0=20"}); });
+    const auto high = caseErrorOf([] { parse("Gamma_k_over_sigma0sq = 10\n", "", {"softening_over_delta0=20"}); });
     EXPECT_EQ(high.exitCode, exit_code::out_of_range);
     expectMessage(high, {"'softening_over_delta0'", "= 20", "(0, 19]", "Gamma_k_over_sigma0sq = 10"});
     const auto highAt3 = caseErrorOf([] { parse("Gamma_k_over_sigma0sq = 3\n", "", {"softening_over_delta0=6"}); });

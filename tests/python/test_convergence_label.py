@@ -1,13 +1,13 @@
 """Every figure title and summary table says whether its runs are size-converged (enamel_results.results):
-only specimens at least 80 x 80 d, at h_e 0.3 d or finer, at the G where convergence was shown, are."""
+only specimens at least 80 x 80 d, at h_e 0.3 d or finer, at the G and tip reading where convergence was shown, are."""
 import types
 
-from enamel_results.results import CONVERGED_G, convergence_label, size_converged
+from enamel_results.results import CONVERGED_G, CONVERGED_TIP, convergence_label, size_converged
 
 
-def run(w, h, h_e=0.3, G=CONVERGED_G):
-    return types.SimpleNamespace(params={"w_s_over_d": w, "h_s_over_d": h, "h_e_over_d": h_e,
-                                         "Gamma_k_over_sigma0sq": G})
+def run(w, h, h_e=0.3, G=CONVERGED_G, tip=CONVERGED_TIP):
+    params = {"w_s_over_d": w, "h_s_over_d": h, "h_e_over_d": h_e, "Gamma_k_over_sigma0sq": G}
+    return types.SimpleNamespace(params=params if tip is None else dict(params, crisscross_at_tip=tip))
 
 
 def test_only_large_square_fine_enough_runs_at_the_shown_G_are_converged():
@@ -16,10 +16,12 @@ def test_only_large_square_fine_enough_runs_at_the_shown_G_are_converged():
     assert not size_converged(run(200, 40))         # wide but not tall
     assert not size_converged(run(80, 80, h_e=0.6))
     assert not size_converged(run(100, 100, G=3))   # converged, but at a G the default no longer has
+    assert not size_converged(run(80, 80, tip="intact"))   # the other tip reading
+    assert not size_converged(run(80, 80, tip=None))       # a run older than the key: its tip was intact
 
 
 def test_the_label_names_the_sizes_and_G_when_any_run_is_not_converged():
     assert convergence_label([run(80, 80), run(100, 100)]) == "size-converged"
     text = convergence_label([run(16, 8), run(80, 80)])
-    assert text.startswith("NOT size-converged") and "16 x 8 d" in text and "G = 10" in text
+    assert text.startswith("NOT size-converged") and "16 x 8 d" in text and f"G = {CONVERGED_G:g}" in text
     assert "G = 3" in convergence_label([run(80, 80, G=3)])
