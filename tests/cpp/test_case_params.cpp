@@ -100,10 +100,10 @@ TEST(CaseParams, MinimalCaseTakesDefaultsAndDerivedQuantities) {
     EXPECT_EQ(p.frames_da_over_d, (std::vector<double>{5, 15, 30}));
     EXPECT_EQ(p.sourceName, "case.toml");
     EXPECT_EQ(p.presetName, "");
-    // k = 1/10, sigma0 = delta0 k = 0.1 k, Gamma = 10 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
+    // k = 1/10, sigma0 = delta0 k = 0.1 k, Gamma = 9 sigma0^2 / k, sigma_ru = 21.4 sigma0, a0 = 0.5 x 32.
     EXPECT_NEAR(p.k(), 0.1, kArithmeticTol * 0.1);
     EXPECT_NEAR(p.sigma0(), 1e-2, kArithmeticTol * 1e-2);
-    EXPECT_NEAR(p.Gamma(), 1e-2, kArithmeticTol * 1e-2);
+    EXPECT_NEAR(p.Gamma(), 9e-3, kArithmeticTol * 9e-3);
     EXPECT_NEAR(p.sigma_ru(), 21.4e-2, kArithmeticTol * 21.4e-2);
     EXPECT_NEAR(p.a0(), 16.0, kArithmeticTol * 16.0);
 }
