@@ -16,7 +16,10 @@ from enamel_results.constants import KINETIC_WARN, LOADING_RATE  # the solver's 
 CASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
 # at G = 3 (the default before 2026-12-04): at G = 10 this ci run's kinetic/strain ratio reaches 0.075 (measured
 # 2026-12-04) past the 0.05 bound, so the adaptive rate x8 is not quasi-static there; the rule is tested where it is
-SETS = ["stop_da_over_d=2", "threads=1", "Gamma_k_over_sigma0sq=3"]   # the ci preset stopped early: 0.6-1.5 s (10,409 steps)
+# and with the intact tip (the default before 2026-12-06): with the cut tip this run's ratio reaches 0.080 at step
+# 5592, before any crack advance (measured 2026-12-06)
+SETS = ["stop_da_over_d=2", "threads=1", "Gamma_k_over_sigma0sq=3",
+        'crisscross_at_tip="intact"']   # the ci preset stopped early: 0.6-1.5 s (10,409 steps)
 RHO_HIGH, RHO_LOW, RAISE, LOWER = (LOADING_RATE[k] for k in ("rho_high", "rho_low", "raise", "lower"))  # loading_rate.hpp
 
 

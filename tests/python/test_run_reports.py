@@ -23,9 +23,12 @@ def over_strain(h, name):
 
 def test_a_run_far_from_quasi_static_is_warned_though_its_crack_never_grows(run, tmp_path):
     # 500 times the ci loading rate, stopped at U = 100 d (~2 s): rods break, interfaces soften, the crack stays.
+    # At G = 10 with the intact tip (the default until 2026-12-06): with the cut tip the crack grows 0.53 d and the
+    # run blows up (kinetic / strain 9.07, measured 2026-12-06), which is not the case tested here.
     out = tmp_path / "fast"
     r = run("run", PAPER_CASES / f"{THETA30}.toml", "--preset", "ci", "--out", out, "--quiet",
-            "--set", "rate_factor=500", "--set", "stop_u_over_d=100", "--set", "threads=1")
+            "--set", "rate_factor=500", "--set", "stop_u_over_d=100", "--set", "threads=1",
+            "--set", "Gamma_k_over_sigma0sq=10", "--set", 'crisscross_at_tip="intact"')
     assert r.returncode == 0, r.stderr
     with h5py.File(out / "result.h5", "r") as f:
         meta, h = f["meta"].attrs, f["history"]
