@@ -58,6 +58,9 @@ STUDY2 = {   # README.md, Study 2, Candidates; the order is its run order
     "margin8_h40_keep": margin(8, 40, None), "margin4_h40_keep": margin(4, 40, None),
 }
 STUDY3 = {"margin8_h20_qs": margin(8, 20), "margin16_h20_qs": margin(16, 20)}   # README.md, Study 3
+# README.md, Study 4: the converged check at the default model (G = 9, cut tip); its reference is the converged
+# set's own record of the case (records/converged/CASE.json: the same keys at phi = 1, the same build)
+STUDY4 = {"s4_margin8_h20_qs": margin(8, 20), "s4_margin4_h10_qs": margin(4, 10)}
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
@@ -65,6 +68,7 @@ STUDY2_ALL = ("phi1_s2", *STUDY2, "margin8_h10_keep", "margin4_h10_keep", "energ
 STUDY1 = tuple(CANDIDATES)
 CANDIDATES.update(STUDY2)
 CANDIDATES.update(STUDY3)
+CANDIDATES.update(STUDY4)
 CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
 # reduced starts as converged does (its preset's own 0.95); the ci smoke run as its preset
 STATIC_START = {"reduced": 0.95, "converged": 0.95, "ci": 0.0}
@@ -267,6 +271,54 @@ def all2(binary: str, preset: str = "reduced", names=STUDY2_ALL) -> int:
     return 0
 
 
+def converged_reference(case: str) -> dict:
+    """Study 4's phi = 1 reference: the converged set's record of the case, in this folder's record form (the
+    R-curve, its steps and the solver's wall seconds; one thread, as the candidates)."""
+    from enamel_results import records as result_records
+    r = result_records.load(paths.record_file("converged", case), case)
+    return dict(meta=dict(steps=int(r.meta["steps"]), git_hash=r.meta["git_hash"]), da=list(map(float, r.da)),
+                R=list(map(float, r.R)), broken_rods=int(r.broken_rods), core_seconds=float(r.meta["wall_time_s"]))
+
+
+def rows4() -> list[dict]:
+    """Study 4's candidates against the converged set's records (S1 in steps, S2, S3; core seconds against the
+    record's wall seconds, indicative only: not run side by side)."""
+    out = []
+    for case in CASES:
+        ref = converged_reference(case)
+        for name in STUDY4:
+            own = DATA / f"converged__{case}__{name}.json"
+            if not own.exists():
+                continue
+            r = json.loads(own.read_text())
+            c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
+            out.append(dict(preset="converged", case=case, candidate=name, steps=r["meta"]["steps"],
+                            core_s=r["core_seconds"], s3=s3_holds(r["events"]), events=r["events"],
+                            steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"],
+                            core_ratio=ref["core_seconds"] / r["core_seconds"] if r["core_seconds"] else float("nan"),
+                            mean_rel=c.mean_rel, init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2,
+                            comparable=c.comparable, same=c.same and s3_holds(r["events"])))
+    return out
+
+
+def report4() -> str:
+    rws = rows4()
+    lines = ["| case | candidate | steps | steps ratio (S1) | core s (ratio to the record's) | mean R rel | R_init rel |"
+             " rods ref/cand | L2 | same (S2) | first break / failure phi (S3) | event intervals at phi 1 |",
+             "|" + "---|" * 12]
+    fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
+    for w in rws:
+        ev = w["events"]
+        same = "yes" if w["same"] else ("no" if w["comparable"] else "not comparable")
+        lines.append(f"| {w['case'].split('_')[0]} | {w['candidate']} | {w['steps']} | {w['steps_ratio']:.2f} | "
+                     f"{w['core_s'] or float('nan'):.0f} ({w['core_ratio']:.2f}) | {100 * w['mean_rel']:+.2f} % | "
+                     f"{100 * w['init_rel']:+.2f} % | {w['rods'][0]}/{w['rods'][1]} | {w['l2']:.3f} | {same} | "
+                     f"{fmt(ev['first_rod_break'])}, {fmt(ev['first_interface_failure'])} "
+                     f"({'holds' if w['s3'] else 'fails'}) | {ev['intervals_at_one']}/{ev['intervals']} |")
+    return "\n".join(lines) + "\n\nDecision: " + decision(rws).replace("goes to the converged check",
+                                                                        "is bench-converged's CONVERGED_SET") + "\n"
+
+
 def report() -> str:
     lines = ["| preset | case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand |"
              " L2 | same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 13]
@@ -300,10 +352,11 @@ def main(argv=None) -> int:
     chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
     chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     for p in (every, rep):
-        p.add_argument("--study", type=int, choices=(1, 2, 3), default=1)
+        p.add_argument("--study", type=int, choices=(1, 2, 3, 4), default=1)
     a = ap.parse_args(argv)
     if a.cmd == "report":
-        print(report() if a.study == 1 else report2(names=STUDY_NAMES[a.study]), end="")
+        print(report() if a.study == 1 else report4() if a.study == 4 else report2(names=STUDY_NAMES[a.study]),
+              end="")
         return 0
     if a.cmd == "check":
         return 0 if check(a.binary)["reuse_study1"] else 1
@@ -311,6 +364,13 @@ def main(argv=None) -> int:
         return run_one(a.binary, a.preset, a.case, a.candidate)
     if a.study in STUDY_NAMES:
         return all2(a.binary, a.preset, STUDY_NAMES[a.study])
+    if a.study == 4:   # README.md, Study 4's order: margin8_h20_qs on both cases, then margin4_h10_qs
+        for name in STUDY4:
+            for case in CASES:
+                rc = run_one(a.binary, "converged", case, name)
+                if rc != 0:
+                    return rc
+        return 0
     for case in CASES:
         for cand in STUDY1:
             rc = run_one(a.binary, a.preset, case, cand)
