@@ -17,6 +17,8 @@
 #                 in records/<preset>/ (commit them: they keep the figures when runs/ is gone; README)
 #   make figures-recorded  [PRESET=...]  every figure (and the summary) whose runs all have a result.h5 or a
 #                 record, from those, running nothing; lists the missing runs of the others
+#   make publish  [PRESET=...]  as figures-recorded, then the figures made and the summary copied into
+#                 docs/figures/<preset>/ (256-colour PNGs, each <= 400 kB) with an index.md of what each was drawn from
 #   make slurm    [PRESET=...] [CASES="run ..."] [SLURM_PARTITION= SLURM_ACCOUNT= SLURM_TIME= SLURM_MEM=
 #                 SLURM_CPUS= SLURM_SIGNAL=300 SLURM_SBATCH="--qos=..." SLURM_THEN="command"]  SLURM job scripts in
 #                 runs/<preset>/slurm/: a job array of the runs (one task each, checkpointed and requeued at the
@@ -97,7 +99,7 @@ RECORD_PRESETS ?= converged paper
 FIG_OUT := $(FIG_ROOT)/$(PRESET)
 
 .PHONY: bench bench-converged bench-step bench-paper help deps build test test-cpp test-python clean figures runs figures-all runs-all \
-  vtk reference clean-runs check-preset slurm records figures-recorded
+  vtk reference clean-runs check-preset slurm records figures-recorded publish
 
 help:
 	@sed -n '1,/^$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,1\}//'
@@ -250,6 +252,11 @@ records: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 
 figures-recorded: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.records figures --preset $(PRESET) --runs $(RUNS) \
+	  --records $(RECORDS) --out $(FIG_ROOT)
+
+# The figures drawn as by figures-recorded, copied small into docs/figures/PRESET/ (PNG <= 400 kB) with an index.
+publish: check-preset $(ENAMEL) $(BUILD_DIR)/figures.mk
+	ENAMEL_BINARY=$(abspath $(ENAMEL)) $(PYTHON) -m pipeline.records publish --preset $(PRESET) --runs $(RUNS) \
 	  --records $(RECORDS) --out $(FIG_ROOT)
 
 # SLURM: job scripts for the runs of the figure set (pipeline/slurm_jobs.py --help). Every task and the figures

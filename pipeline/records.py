@@ -5,6 +5,7 @@
     python3 -m pipeline.records check RECORD_JSON [--result RESULT_H5]       is it a record, and of that file?
     python3 -m pipeline.records update --preset P [--runs R] [--records D]   `make records`
     python3 -m pipeline.records figures --preset P [--runs R] [--records D] [--out O]   `make figures-recorded`
+    python3 -m pipeline.records publish --preset P [--runs R] [--records D] [--docs DIR]  `make publish`
 
 update records every completed run of the figure set (runs/P/<run>/result.h5) that has no record in
 records/P/<run>.json, or whose record is of another, older run (its sha256 differs and its /meta written_utc is
@@ -13,6 +14,10 @@ there, or a damaged result file, stops it before anything is written (one line n
 figures makes every figure (and the summary table) whose cases all have a run or a record, from those, running
 nothing, and lists the missing cases of the others (half-rate twins are optional: a figure without them is drawn
 without them, as the figure scripts do).
+publish draws as figures does, then copies each figure made and the summary into DIR/P/ (default docs/figures/P/)
+as small committed files: each PNG reduced to a 256-colour palette and refused above PUBLISHED_PNG_BYTES, the
+summary.md as it is, and an index.md saying when, from which solver commits, and for each figure the runs it
+was drawn from, the twins it lacks or the cases still missing. A figure not made leaves its earlier copy out.
 """
 from __future__ import annotations
 
@@ -131,32 +136,105 @@ def solver_commits(a, runs: list[tuple[str, bool]]) -> str:
     return ", ".join(f"{c} ({n})" for c, n in sorted(count.items(), key=lambda kv: -kv[1])) or "none"
 
 
-def cmd_figures(a) -> int:
+PUBLISHED_PNG_BYTES = 400_000   # the most a published figure may weigh (docs/ is in git)
+
+
+def draw_figures(a) -> list[dict]:
+    """Each figure (and the summary table) drawn where its cases all have a run or a record: a dict per job with
+    its name, module, status ('made', 'failed', 'missing'), cases, and the missing cases or twins."""
     figures = cases.figure_list()
     jobs = [(f"figures.{stem}", fig, figures[fig]) for fig, stem in cases.figure_scripts().items()]
     everything = {"cases": list(dict.fromkeys(c for e in figures.values() for c in e.get("cases", []))),
                   "slow": list(dict.fromkeys(c for e in figures.values() for c in e.get("slow", [])))}
     jobs.append(("figures.summary_table", "summary table", everything))
-    made, failed = 0, 0
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(paths.ROOT), os.environ.get("PYTHONPATH")])))
+    done = []
     for module, name, table in jobs:
-        missing = [c for c in table.get("cases", []) if not available(a, c)]
-        if missing:
-            print(f"figures-recorded: {name}: not made, {len(missing)} of {len(table['cases'])} cases have neither a "
-                  f"run nor a record: {' '.join(missing)}")
+        job = dict(name=name, module=module, cases=list(table.get("cases", [])),
+                   missing=[c for c in table.get("cases", []) if not available(a, c)],
+                   no_twin=[c for c in table.get("slow", []) if not available(a, c, slow=True)])
+        done.append(job)
+        if job["missing"]:
+            job["status"] = "missing"
+            print(f"figures-recorded: {name}: not made, {len(job['missing'])} of {len(job['cases'])} cases have "
+                  f"neither a run nor a record: {' '.join(job['missing'])}")
             continue
-        no_twin = [c for c in table.get("slow", []) if not available(a, c, slow=True)]
         cmd = [sys.executable, "-m", module, "--preset", a.preset, "--runs", str(a.runs), "--records", str(a.records)]
         cmd += ["--out", str(a.out)] if a.out is not None else []
-        print(f"figures-recorded: {name}: from {len(table['cases'])} runs and records" +
-              (f" (without the half-rate twin of {' '.join(no_twin)})" if no_twin else ""), flush=True)
-        r = subprocess.run(cmd, cwd=paths.ROOT, env=env)
-        made += r.returncode == 0
-        failed += r.returncode != 0
+        print(f"figures-recorded: {name}: from {len(job['cases'])} runs and records" +
+              (f" (without the half-rate twin of {' '.join(job['no_twin'])})" if job["no_twin"] else ""), flush=True)
+        job["status"] = "made" if subprocess.run(cmd, cwd=paths.ROOT, env=env).returncode == 0 else "failed"
+    return done
+
+
+def cmd_figures(a) -> int:
+    jobs = draw_figures(a)
+    made, failed = (sum(j["status"] == s for j in jobs) for s in ("made", "failed"))
     print(f"figures-recorded: {made} of {len(jobs)} made in {paths.figure_dir(a.preset, a.out)}/"
           + (f", {failed} failed" if failed else "") + f"; solver commits of the runs and records: "
           f"{solver_commits(a, figure_runs())}")
     return 1 if failed else 0
+
+
+def palette_png(source: pathlib.Path, target: pathlib.Path) -> int:
+    """The figure reduced to a 256-colour palette (the figures' few flat colours survive it), written to target;
+    its size in bytes."""
+    from PIL import Image
+    with Image.open(source) as im:
+        im.convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT,
+                                   dither=Image.Dither.NONE).save(target, optimize=True)
+    return target.stat().st_size
+
+
+def publish_index(a, jobs: list[dict], published: list[str]) -> str:
+    """docs/figures/P/index.md: when and from what the published figures were drawn, and what is still missing."""
+    lines = [f"# The `{a.preset}` figure set as published", "",
+             f"Drawn {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by `make publish PRESET={a.preset}` "
+             f"(`python3 -m pipeline.records publish`) from the runs and records there; solver commits (runs): "
+             f"{solver_commits(a, figure_runs())}. Each figure is the one `make figures-recorded` draws, reduced to a "
+             f"256-colour palette.", "", "| figure | file | drawn from |", "|---|---|---|"]
+    for j in jobs:
+        stem = j["module"].split(".")[-1]
+        if j["status"] == "made":
+            file = f"[{stem}.png]({stem}.png)" if f"{stem}.png" in published else \
+                ("[summary.md](summary.md)" if "summary.md" in published else "-")
+            twins = f"; without the half-rate twin of {', '.join(j['no_twin'])}" if j["no_twin"] else ""
+            lines.append(f"| {j['name']} | {file} | {len(j['cases'])} runs and records{twins} |")
+        elif j["status"] == "missing":
+            lines.append(f"| {j['name']} | not drawn | {len(j['cases']) - len(j['missing'])} of {len(j['cases'])} "
+                         f"runs and records; missing: {', '.join(j['missing'])} |")
+        else:
+            lines.append(f"| {j['name']} | not drawn | its script failed (run `make figures-recorded`) |")
+    return "\n".join(lines) + "\n"
+
+
+def cmd_publish(a) -> int:
+    jobs = draw_figures(a)
+    source, target = paths.figure_dir(a.preset, a.out), a.docs / a.preset
+    target.mkdir(parents=True, exist_ok=True)
+    published, too_big = [], []
+    for j in jobs:
+        stem = j["module"].split(".")[-1]
+        name = "summary.md" if stem == "summary_table" else f"{stem}.png"
+        if j["status"] != "made":
+            (target / name).unlink(missing_ok=True)   # an earlier copy would disagree with the index
+            continue
+        if stem == "summary_table":
+            (target / "summary.md").write_bytes((source / "summary.md").read_bytes())
+            published.append("summary.md")
+            continue
+        size = palette_png(source / f"{stem}.png", target / f"{stem}.png")
+        if size > PUBLISHED_PNG_BYTES:
+            (target / f"{stem}.png").unlink()
+            too_big.append(f"{stem}.png ({size / 1000:.0f} kB)")
+        else:
+            published.append(f"{stem}.png")
+    (target / "index.md").write_text(publish_index(a, jobs, published))
+    print(f"publish: {len(published)} files in {target}/ ({', '.join(published) or 'none'}) and index.md")
+    if too_big:
+        print(f"publish: refused above {PUBLISHED_PNG_BYTES / 1000:.0f} kB after the palette: {', '.join(too_big)}",
+              file=sys.stderr)
+    return 1 if too_big or any(j["status"] == "failed" for j in jobs) else 0
 
 
 def parser() -> argparse.ArgumentParser:
@@ -172,15 +250,20 @@ def parser() -> argparse.ArgumentParser:
     c.add_argument("record", type=pathlib.Path)
     c.add_argument("--result", type=pathlib.Path, default=None, help="the result.h5 it should be a record of")
     for name, text in (("update", "record every completed run of a preset that has no record or an older one"),
-                       ("figures", "make every figure whose cases all have a run or a record, running nothing")):
+                       ("figures", "make every figure whose cases all have a run or a record, running nothing"),
+                       ("publish", "draw as figures does, then copy the figures made and the summary into "
+                                   "DOCS/PRESET/ as small files, with an index")):
         p = sub.add_parser(name, help=text, description=text)
         p.add_argument("--preset", required=True, help="ci | reduced | converged | paper")
         p.add_argument("--runs", type=pathlib.Path, default=paths.RUNS, help=f"root of the runs (default {paths.RUNS})")
         p.add_argument("--records", type=pathlib.Path, default=paths.RECORDS,
                        help=f"root of the records (default {paths.RECORDS})")
-        if name == "figures":
+        if name in ("figures", "publish"):
             p.add_argument("--out", type=pathlib.Path, default=None,
                            help=f"root of the figures instead of {paths.FIGURES_OUT}; files go to OUT/PRESET/")
+        if name == "publish":
+            p.add_argument("--docs", type=pathlib.Path, default=paths.ROOT / "docs" / "figures",
+                           help="root of the published copies (default docs/figures); files go to DOCS/PRESET/")
     return ap
 
 
@@ -190,7 +273,8 @@ def main(argv=None) -> int:
         print(f"records: {a.record}: a record's name ends in {paths.RECORD_SUFFIX}", file=sys.stderr)
         return 2
     try:
-        return {"write": cmd_write, "check": cmd_check, "update": cmd_update, "figures": cmd_figures}[a.command](a)
+        return {"write": cmd_write, "check": cmd_check, "update": cmd_update, "figures": cmd_figures,
+                "publish": cmd_publish}[a.command](a)
     except (FileNotFoundError, MissingResult) as e:
         print(f"records: no such file: {getattr(e, 'filename', None) or e.path}", file=sys.stderr)
         return EXIT_MISSING

@@ -295,6 +295,31 @@ def test_make_records_and_figures_recorded(enamel, tiny, tmp_path):
     assert "figures-recorded: 1 of 7 made" in r.stdout, r.stdout
 
 
+def test_publish_copies_the_figures_made_small_with_an_index(tiny, tmp_path, monkeypatch, capsys):
+    """publish (make publish): the figures whose runs are all there go to DOCS/PRESET/ as 256-colour PNGs under the
+    size limit, an earlier copy of a figure not made now is removed, and index.md says what each was drawn from
+    and what is missing; a figure over the limit after the palette is refused (exit 1) and not left there."""
+    from PIL import Image
+    docs, out = tmp_path / "docs", tmp_path / "out"
+    (docs / "ci").mkdir(parents=True)
+    (docs / "ci" / "fig5_rod_strength.png").write_bytes(b"stale")
+    args = ["publish", "--preset", "ci", "--runs", str(tiny), "--records", str(tmp_path / "none"),
+            "--out", str(out), "--docs", str(docs)]
+    assert records_cli.main(args) == 0, capsys.readouterr()
+    png = docs / "ci" / "fig4_decussation.png"
+    with Image.open(png) as im:
+        assert im.mode == "P" and im.size == Image.open(out / "ci" / "fig4_decussation.png").size
+    assert 0 < png.stat().st_size <= records_cli.PUBLISHED_PNG_BYTES
+    assert not (docs / "ci" / "fig5_rod_strength.png").exists(), "a stale copy disagrees with the index"
+    index = (docs / "ci" / "index.md").read_text()
+    assert "| fig4 | [fig4_decussation.png](fig4_decussation.png) | 3 runs and records |" in index, index
+    fig5 = next(line for line in index.splitlines() if line.startswith("| fig5 |"))
+    assert "not drawn" in fig5 and "theta30_s7.1_e10_cv0" in fig5, fig5
+    monkeypatch.setattr(records_cli, "PUBLISHED_PNG_BYTES", 1000)
+    assert records_cli.main(args) == 1
+    assert not png.exists() and "refused above 1 kB after the palette: fig4_decussation.png" in capsys.readouterr().err
+
+
 def test_update_rewrites_a_record_of_an_older_run_and_keeps_one_of_a_newer_run(tiny, tmp_path, capsys):
     runs, recs = tmp_path / "runs", tmp_path / "records"
     (runs / "ci" / BROKEN).mkdir(parents=True)
