@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "file_io.hpp"
 #include "geometry.hpp"
 #include "integrators.hpp"
+#include "loading_rate.hpp"
 #include "profile.hpp"
 #include "resources.hpp"
 #include "runner.hpp"
@@ -111,11 +113,23 @@ int runInfo(const CaseArgs& args, bool estimateOnly) {
   return exit_code::ok;
 }
 
-// Time the step's phases on the case's model (profile.hpp) and print the table; writes nothing else.
-int runProfile(const CaseArgs& args, long warmup, long steps) {
+// Time the step's phases on the case's model (profile.hpp) and print the table; writes nothing else. With
+// rateMultiplier > 0 the loading clock runs at that phi from the start (the adaptive rate held, no controller), or
+// ramps from it to rateTarget over the warm-up and timed steps, as a run's controller ramps it between rows.
+int runProfile(const CaseArgs& args, long warmup, long steps, double rateMultiplier, double rateTarget) {
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
+  const double phiMax = std::max(rateMultiplier, rateTarget);
+  if (phiMax > p.rate_adapt_max) {
+    std::fprintf(stderr, "error: --rate-multiplier / --rate-target = %g is above rate_adapt_max = %g; allowed: [1, "
+                 "rate_adapt_max] (add --set rate_adapt_max=%g)\n", phiMax, p.rate_adapt_max, phiMax);
+    return exit_code::usage;
+  }
   if (int rc = checkMemory(p)) return rc;
   Simulation sim(p);
+  if (rateMultiplier > 0) {
+    sim.state.rateMultiplier = sim.state.rateMultiplierTarget = rateMultiplier;
+    if (rateTarget > 0) setRateMultiplierTarget(sim.state, rateTarget, warmup + steps);
+  }
   std::printf("%s", formatProfileMarkdown(profileStep(sim, warmup, steps)).c_str());
   return exit_code::ok;
 }
@@ -297,6 +311,13 @@ int main(int argc, char** argv) {
   profileArgs.addTo(profile);
   profile->add_option("--warmup", profileWarmup, "steps run before timing")->check(CLI::NonNegativeNumber);
   profile->add_option("--steps", profileSteps, "steps timed")->check(CLI::PositiveNumber);
+  double profilePhi = 0, profilePhiTarget = 0;
+  profile->add_option("--rate-multiplier", profilePhi,
+                      "run the loading clock at this phi from the start (the adaptive rate held; needs rate_adapt_max "
+                      ">= it)")->check(CLI::Range(1.0, 1e6));
+  profile->add_option("--rate-target", profilePhiTarget,
+                      "ramp phi from --rate-multiplier to this over the warm-up and timed steps (as a run's controller "
+                      "ramps it between rows)")->check(CLI::Range(1.0, 1e6))->needs("--rate-multiplier");
 
   CLI::App* keys = app.add_subcommand("keys", "list every case key: meaning, unit, default, allowed range (Markdown)");
   bool constantsJson = false;
@@ -323,7 +344,7 @@ int main(int argc, char** argv) {
     if (*constants) { std::cout << (constantsJson ? sharedConstantsJson() : sharedConstantsToml()); return exit_code::ok; }
     if (*info) return runInfo(infoArgs, estimateOnly);
     if (*run) return runRun(runArgs, flags);
-    if (*profile) return runProfile(profileArgs, profileWarmup, profileSteps);
+    if (*profile) return runProfile(profileArgs, profileWarmup, profileSteps, profilePhi, profilePhiTarget);
   } catch (const std::exception& e) {
     return fail(exitCodeOf(e), e.what());
   }

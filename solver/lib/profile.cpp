@@ -105,6 +105,8 @@ StepProfile profileStep(Simulation& sim, long warmup, long steps) {
   sim.setTimers(&timers);
   long computed = 0, evaluated = 0;  // rod elements the deletion check computed, interfaces the law saw
   double seconds = 0;
+  p.displacementBefore = sim.state.appliedDisplacement;
+  p.phiBefore = sim.state.rateMultiplier;
   for (long i = 0; i < steps; ++i) {
     const auto t0 = clock::now();
     sim.step();
@@ -113,6 +115,8 @@ StepProfile profileStep(Simulation& sim, long warmup, long steps) {
     if (const InterfaceSchedule* schedule = sim.integrator->interfaceSchedule()) evaluated += schedule->evaluated;
   }
   sim.setTimers(nullptr);
+  p.displacementAfter = sim.state.appliedDisplacement;
+  p.phiAfter = sim.state.rateMultiplier;
   const Model& m = sim.model;
   p.secondsPerStep = seconds / steps;
   p.stressComputedFraction = sim.materials.rodsBreakable ? static_cast<double>(computed) / (steps * std::max(1, m.numBeams())) : 0.0;
@@ -168,6 +172,9 @@ std::string formatProfileMarkdown(const StepProfile& p) {
   for (const PhaseTiming& t : p.phases)
     o << profileRow(kStepPhases[static_cast<int>(t.phase)].name, 1 + kStepPhases[static_cast<int>(t.phase)].depth,
                     t.secondsPerStep, step, t.lapsPerStep, t.bytesPerStep, p.triadBytesPerSecond, t.what);
+  std::snprintf(buf, sizeof buf, "\nloading over the timed steps: U/d %.6g -> %.6g, phi %.4g -> %.4g\n",
+                p.displacementBefore, p.displacementAfter, p.phiBefore, p.phiAfter);
+  o << buf;
   return o.str();
 }
 

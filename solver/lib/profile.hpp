@@ -35,6 +35,8 @@ struct StepProfile {
   double stressComputedFraction = 0;  // rod elements the scheduled deletion check computed, per step, of all
   double interfaceEvaluatedFraction = NAN;  // interfaces the lumped step's law saw (InterfaceSchedule), per step
   std::vector<PhaseTiming> phases;  // those the step timed, in the order of kStepPhases
+  double displacementBefore = 0, displacementAfter = 0;  // the applied displacement U before and after the timed steps
+  double phiBefore = 1, phiAfter = 1;                    // the loading rate's multiplier then (State::rateMultiplier)
 };
 
 /// Advance the simulation `warmup` steps, then `steps` more with its timers on (Simulation::setTimers), each
@@ -44,7 +46,8 @@ StepProfile profileStep(Simulation& sim, long warmup, long steps);
 
 /// The profile as a Markdown table (phase, ms/step, share of the step, laps/step, MB/step, GB/s, % of the
 /// triad, what it times), the phases indented under the step and their parents, with a header line naming the
-/// model size, threads, scheme, steps, ms/step and DOF-updates/s per core.
+/// model size, threads, scheme, steps, ms/step and DOF-updates/s per core, and a line after it with the loading
+/// over the timed steps (U/d and phi before and after: `enamel-dem profile --rate-multiplier` holds or ramps phi).
 std::string formatProfileMarkdown(const StepProfile& p);
 
 }  // namespace enamel

@@ -116,6 +116,33 @@ def test_profile_times_each_phase_of_either_scheme(enamel):
     assert rows["rod forces"][2] == 1
 
 
+def test_profile_holds_or_ramps_the_loading_rate(enamel):
+    """`enamel-dem profile --rate-multiplier PHI [--rate-target PHI2]` profiles the step with the loading clock at
+    phi (as a run of the adaptive rate does between its rows): the grips move further over the same timed steps
+    at phi = 4 than at 1, a ramp ends at its target, and a phi above rate_adapt_max is refused before any model
+    is built (exit 2, naming the option, the value and the key)."""
+    import re
+    case = str(ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml")
+    args = [str(enamel), "profile", case, "--preset", "ci", "--set", "w_s_over_d=8", "--set", "h_s_over_d=4",
+            "--set", "threads=1", "--steps", "10", "--warmup", "20", "--set", "rate_adapt_max=4"]
+
+    def loading(extra):
+        r = subprocess.run(args + extra, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        m = re.search(r"loading over the timed steps: U/d (\S+) -> (\S+), phi (\S+) -> (\S+)", r.stdout)
+        assert m, r.stdout
+        return [float(x) for x in m.groups()]
+    u0, u1, p0, p1 = loading([])
+    assert (p0, p1) == (1.0, 1.0) and u1 > u0 > 0
+    v0, v1, q0, q1 = loading(["--rate-multiplier", "4"])
+    assert (q0, q1) == (4.0, 4.0) and v1 - v0 > 2 * (u1 - u0)
+    _, _, r0, r1 = loading(["--rate-multiplier", "4", "--rate-target", "2"])
+    assert 2.0 < r0 < 4.0 and r1 == 2.0   # linear from 4 over the 30 steps: 4 - 2 x 20/30 after the warm-up
+    r = subprocess.run(args[:-2] + ["--rate-multiplier", "4"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "rate_adapt_max" in r.stderr and "4" in r.stderr, r.stderr
+    assert "|" not in r.stdout
+
+
 def start_paper_preset(enamel, tmp_path):
     """bench/paper_preset.py --quick on a run long enough to interrupt, started in a process group of its own (as a
     terminal's process group); returns once the solver has written its first partial result."""
