@@ -186,6 +186,12 @@ def palette_png(source: pathlib.Path, target: pathlib.Path) -> int:
     return target.stat().st_size
 
 
+def published_name(job: dict) -> str:
+    """The file a drawing job publishes: its figure's PNG, or the summary table's summary.md."""
+    stem = job["module"].split(".")[-1]
+    return "summary.md" if stem == "summary_table" else f"{stem}.png"
+
+
 def publish_index(a, jobs: list[dict], published: list[str]) -> str:
     """docs/figures/P/index.md: when and from what the published figures were drawn, and what is still missing."""
     lines = [f"# The `{a.preset}` figure set as published", "",
@@ -194,10 +200,9 @@ def publish_index(a, jobs: list[dict], published: list[str]) -> str:
              f"{solver_commits(a, figure_runs())}. Each figure is the one `make figures-recorded` draws, reduced to a "
              f"256-colour palette.", "", "| figure | file | drawn from |", "|---|---|---|"]
     for j in jobs:
-        stem = j["module"].split(".")[-1]
         if j["status"] == "made":
-            file = f"[{stem}.png]({stem}.png)" if f"{stem}.png" in published else \
-                ("[summary.md](summary.md)" if "summary.md" in published else "-")
+            name = published_name(j)
+            file = f"[{name}]({name})" if name in published else "-"
             twins = f"; without the half-rate twin of {', '.join(j['no_twin'])}" if j["no_twin"] else ""
             lines.append(f"| {j['name']} | {file} | {len(j['cases'])} runs and records{twins} |")
         elif j["status"] == "missing":
@@ -214,21 +219,20 @@ def cmd_publish(a) -> int:
     target.mkdir(parents=True, exist_ok=True)
     published, too_big = [], []
     for j in jobs:
-        stem = j["module"].split(".")[-1]
-        name = "summary.md" if stem == "summary_table" else f"{stem}.png"
+        name = published_name(j)
         if j["status"] != "made":
             (target / name).unlink(missing_ok=True)   # an earlier copy would disagree with the index
             continue
-        if stem == "summary_table":
-            (target / "summary.md").write_bytes((source / "summary.md").read_bytes())
-            published.append("summary.md")
+        if name.endswith(".md"):
+            (target / name).write_bytes((source / name).read_bytes())
+            published.append(name)
             continue
-        size = palette_png(source / f"{stem}.png", target / f"{stem}.png")
+        size = palette_png(source / name, target / name)
         if size > PUBLISHED_PNG_BYTES:
-            (target / f"{stem}.png").unlink()
-            too_big.append(f"{stem}.png ({size / 1000:.0f} kB)")
+            (target / name).unlink()
+            too_big.append(f"{name} ({size / 1000:.0f} kB)")
         else:
-            published.append(f"{stem}.png")
+            published.append(name)
     (target / "index.md").write_text(publish_index(a, jobs, published))
     print(f"publish: {len(published)} files in {target}/ ({', '.join(published) or 'none'}) and index.md")
     if too_big:

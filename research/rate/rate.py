@@ -194,6 +194,39 @@ def study2_record(preset: str, case: str, name: str) -> dict | None:
     return json.loads(old.read_text()) if reuse and name in STUDY1_AS and old.exists() else None
 
 
+def judged_row(preset: str, case: str, name: str, r: dict, ref: dict | None) -> dict:
+    """One candidate's record against its reference's (None: no reference): S1 in steps, S2 (the measure's numbers),
+    S3."""
+    row = dict(preset=preset, case=case, candidate=name, steps=r["meta"]["steps"], core_s=r["core_seconds"],
+               s3=s3_holds(r["events"]), events=r["events"])
+    if ref is not None:
+        c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
+        row.update(steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"], mean_rel=c.mean_rel,
+                   init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, comparable=c.comparable,
+                   same=c.same)
+    return row
+
+
+def judged_table(rws: list[dict], core_ratio: bool = False) -> list[str]:
+    """The rows of judged_row as a Markdown table (with core_ratio: the core seconds' ratio to the reference's
+    beside them)."""
+    core = "core s (ratio to the record's)" if core_ratio else "core s"
+    lines = [f"| case | candidate | steps | steps ratio (S1) | {core} | mean R rel | R_init rel | rods ref/cand | L2 |"
+             " same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 12]
+    fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
+    for w in rws:
+        ev = w["events"]
+        same = "yes" if w.get("same") else ("no" if w.get("comparable") else "not comparable")
+        core_s = f"{w['core_s'] or float('nan'):.0f}" + (f" ({w['core_ratio']:.2f})" if core_ratio else "")
+        lines.append(f"| {w['case'].split('_')[0]} | {w['candidate']} | {w['steps']} | {w.get('steps_ratio', float('nan')):.2f} | "
+                     f"{core_s} | {100 * w.get('mean_rel', float('nan')):+.2f} % | "
+                     f"{100 * w.get('init_rel', float('nan')):+.2f} % | {'/'.join(map(str, w.get('rods', ('-', '-'))))} | "
+                     f"{w.get('l2', float('nan')):.3f} | {same} | {fmt(ev['first_rod_break'])}, "
+                     f"{fmt(ev['first_interface_failure'])} ({'holds' if w['s3'] else 'fails'}) | "
+                     f"{ev['intervals_at_one']}/{ev['intervals']} |")
+    return lines
+
+
 def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
     """Study 2's (or 3's) candidates against study 2's reference (phi1_s2, or study 1's phi1 when the check
     passed)."""
@@ -202,16 +235,8 @@ def rows2(preset: str = "reduced", names=STUDY2_ALL) -> list[dict]:
         ref = study2_record(preset, case, "phi1_s2")
         for name in names:
             r = study2_record(preset, case, name)
-            if r is None:
-                continue
-            row = dict(preset=preset, case=case, candidate=name, steps=r["meta"]["steps"], core_s=r["core_seconds"],
-                       s3=s3_holds(r["events"]), events=r["events"])
-            if ref is not None:
-                c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
-                row.update(steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"], mean_rel=c.mean_rel,
-                           init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2, comparable=c.comparable,
-                           same=c.same)
-            out.append(row)
+            if r is not None:
+                out.append(judged_row(preset, case, name, r, ref))
     return out
 
 
@@ -242,18 +267,7 @@ def decision(rws: list[dict], above: float = 0.0) -> str:
 def report2(preset: str = "reduced", names=STUDY2_ALL) -> str:
     rws = rows2(preset, names)
     study2 = best(rows2(preset)) if names != STUDY2_ALL else None   # study 3: above study 2's choice
-    lines = ["| case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand | L2 |"
-             " same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 12]
-    fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
-    for w in rws:
-        ev = w["events"]
-        same = "yes" if w.get("same") else ("no" if w.get("comparable") else "not comparable")
-        lines.append(f"| {w['case'].split('_')[0]} | {w['candidate']} | {w['steps']} | {w.get('steps_ratio', float('nan')):.2f} | "
-                     f"{w['core_s'] or float('nan'):.0f} | {100 * w.get('mean_rel', float('nan')):+.2f} % | "
-                     f"{100 * w.get('init_rel', float('nan')):+.2f} % | {'/'.join(map(str, w.get('rods', ('-', '-'))))} | "
-                     f"{w.get('l2', float('nan')):.3f} | {same} | {fmt(ev['first_rod_break'])}, "
-                     f"{fmt(ev['first_interface_failure'])} ({'holds' if w['s3'] else 'fails'}) | "
-                     f"{ev['intervals_at_one']}/{ev['intervals']} |")
+    lines = judged_table(rws)
     above = f" (study 3's rule: above study 2's {study2[0]}, {study2[1]:.2f})" if study2 else ""
     return "\n".join(lines) + f"\n\nDecision{above}: " + decision(rws, study2[1] if study2 else 0.0) + "\n"
 
@@ -281,8 +295,8 @@ def converged_reference(case: str) -> dict:
 
 
 def rows4() -> list[dict]:
-    """Study 4's candidates against the converged set's records (S1 in steps, S2, S3; core seconds against the
-    record's wall seconds, indicative only: not run side by side)."""
+    """Study 4's candidates against the converged set's records (judged_row; eligible (same) only with S3 too; core
+    seconds against the record's wall seconds, indicative only: not run side by side)."""
     out = []
     for case in CASES:
         ref = converged_reference(case)
@@ -290,33 +304,17 @@ def rows4() -> list[dict]:
             own = DATA / f"converged__{case}__{name}.json"
             if not own.exists():
                 continue
-            r = json.loads(own.read_text())
-            c = metrics.same_rcurve(curve(ref), curve(r), metrics.TOL_RATE_SPEED)
-            out.append(dict(preset="converged", case=case, candidate=name, steps=r["meta"]["steps"],
-                            core_s=r["core_seconds"], s3=s3_holds(r["events"]), events=r["events"],
-                            steps_ratio=ref["meta"]["steps"] / r["meta"]["steps"],
-                            core_ratio=ref["core_seconds"] / r["core_seconds"] if r["core_seconds"] else float("nan"),
-                            mean_rel=c.mean_rel, init_rel=c.init_rel, rods=(c.rods_a, c.rods_b), l2=c.l2,
-                            comparable=c.comparable, same=c.same and s3_holds(r["events"])))
+            row = judged_row("converged", case, name, json.loads(own.read_text()), ref)
+            row.update(core_ratio=ref["core_seconds"] / row["core_s"] if row["core_s"] else float("nan"),
+                       same=row["same"] and row["s3"])
+            out.append(row)
     return out
 
 
 def report4() -> str:
     rws = rows4()
-    lines = ["| case | candidate | steps | steps ratio (S1) | core s (ratio to the record's) | mean R rel | R_init rel |"
-             " rods ref/cand | L2 | same (S2) | first break / failure phi (S3) | event intervals at phi 1 |",
-             "|" + "---|" * 12]
-    fmt = lambda e: "-" if e is None else "/".join(f"{x:.3g}" for x in e)
-    for w in rws:
-        ev = w["events"]
-        same = "yes" if w["same"] else ("no" if w["comparable"] else "not comparable")
-        lines.append(f"| {w['case'].split('_')[0]} | {w['candidate']} | {w['steps']} | {w['steps_ratio']:.2f} | "
-                     f"{w['core_s'] or float('nan'):.0f} ({w['core_ratio']:.2f}) | {100 * w['mean_rel']:+.2f} % | "
-                     f"{100 * w['init_rel']:+.2f} % | {w['rods'][0]}/{w['rods'][1]} | {w['l2']:.3f} | {same} | "
-                     f"{fmt(ev['first_rod_break'])}, {fmt(ev['first_interface_failure'])} "
-                     f"({'holds' if w['s3'] else 'fails'}) | {ev['intervals_at_one']}/{ev['intervals']} |")
-    return "\n".join(lines) + "\n\nDecision: " + decision(rws).replace("goes to the converged check",
-                                                                        "is bench-converged's CONVERGED_SET") + "\n"
+    return "\n".join(judged_table(rws, core_ratio=True)) + "\n\nDecision: " + \
+        decision(rws).replace("goes to the converged check", "is bench-converged's CONVERGED_SET") + "\n"
 
 
 def report() -> str:

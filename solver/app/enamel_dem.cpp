@@ -120,9 +120,10 @@ int runProfile(const CaseArgs& args, long warmup, long steps, double rateMultipl
   const CaseParams p = loadCase(args.casePath, args.preset, args.sets);
   const double phiMax = std::max(rateMultiplier, rateTarget);
   if (phiMax > p.rate_adapt_max) {
-    std::fprintf(stderr, "error: --rate-multiplier / --rate-target = %g is above rate_adapt_max = %g; allowed: [1, "
-                 "rate_adapt_max] (add --set rate_adapt_max=%g)\n", phiMax, p.rate_adapt_max, phiMax);
-    return exit_code::usage;
+    char msg[256];
+    std::snprintf(msg, sizeof msg, "--rate-multiplier / --rate-target = %g is above rate_adapt_max = %g; allowed: "
+                  "[1, rate_adapt_max] (add --set rate_adapt_max=%g)", phiMax, p.rate_adapt_max, phiMax);
+    return fail(exit_code::usage, msg);
   }
   if (int rc = checkMemory(p)) return rc;
   Simulation sim(p);
