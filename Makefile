@@ -117,8 +117,10 @@ deps:
 	$$SUDO apt-get update -qq && \
 	DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing
 
+# cmake leaves an unchanged cache's time alone: touch it, or every make (and two at once, racing) configures again
 $(BUILD_DIR)/CMakeCache.txt: CMakeLists.txt | deps
 	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+	touch $@
 
 build: deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS)
