@@ -20,7 +20,9 @@ each piece (UTC) and the solver's commit. Per case: the ratio of core-seconds (b
 (fewer steps; cheaper steps), and "the same R-curve" by enamel_results.metrics.same_rcurve at the rate-and-speed
 tolerance (R averaged over (0,30] d and R_init within 2%, broken rods within 20%; the pointwise L2 reported,
 not deciding) against the reference, computed as `make bench` computes it (bench.run_bench.speed_comparison);
-the levers' own ratio (reference / new core-seconds) and the baseline's R-curve against the new one beside it.
+the levers' own ratio (reference / new core-seconds) and the baseline's R-curve against the new one beside it;
+the new run's share of steps at loading-rate multiplier phi = 1 and the ratio / that share, which bounds what a
+higher phi_max of an adaptive rate could reach while the steps near events stay at phi = 1.
 The verdict: the ratio at least --goal (3) and the same R-curve as the reference; a case that misses says what
 it reached and by which factor.
 
@@ -45,6 +47,9 @@ import shutil
 import signal
 import subprocess
 import sys
+
+import h5py
+import numpy as np
 
 import bench
 from bench import run_bench
@@ -230,6 +235,22 @@ def differences(c: metrics.Comparison) -> str:
     return ", ".join(out + ([] if c.rods_ok else [f"rods {c.rods_a} / {c.rods_b}"]))
 
 
+def unit_rate_share(result_file: pathlib.Path) -> float | None:
+    """The share of a run's steps in history intervals with the loading-rate multiplier phi = 1 at both ends
+    (/history/rate_multiplier; None for a solver without that column). With an adaptive rate those are the steps
+    it could not take faster (approaching and following events), so ratio / share bounds the cost ratio that any
+    higher phi_max could reach while the same steps stay at phi = 1."""
+    with h5py.File(result_file, "r") as f:
+        h = f["history"]
+        if "rate_multiplier" not in h:
+            return None
+        step, phi = np.asarray(h["step"], dtype=float), np.asarray(h["rate_multiplier"])
+    if step.size < 2 or step[-1] <= step[0]:
+        return None
+    at_one = (phi[:-1] == 1) & (phi[1:] == 1)
+    return float(np.diff(step)[at_one].sum() / (step[-1] - step[0]))
+
+
 def done(out: pathlib.Path) -> bool:
     return completed(out) and bool(read_record(out).get("pieces"))
 
@@ -251,6 +272,9 @@ def case_row(case: str, base: pathlib.Path, ref: pathlib.Path, new: pathlib.Path
     row.update(status="complete", ratio=ratio, fewer_steps=b["steps"] / n["steps"],
                cheaper_step=(b["core_s"] / b["steps"] / b["dof"]) / (n["core_s"] / n["steps"] / n["dof"]),
                lever_ratio=r["core_s"] / n["core_s"], reference_is_new=(ref == new))
+    share = unit_rate_share(new / paths.RESULT_NAMES["completed"])
+    if share:
+        row.update(new_unit_rate_share=share, ratio_bound=ratio / share)
     if same is not None:
         row.update(range_hi=same.hi, R_mean_reference=same.mean_a, R_mean_new=same.mean_b, R_mean_rel=same.mean_rel,
                    R_init_rel=same.init_rel, rods_reference=same.rods_a, rods_new=same.rods_b, rcurve_l2=same.l2,
@@ -277,15 +301,18 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"(bench/converged_cost.py). Baseline: the build of {header['baseline']} (solver {header['baseline_git']}). "
          f"New: solver {header['new_git']}{header['new_sets']}. Reference: {header['reference']}. Core-seconds: the "
          f"solver process's CPU time (user + system) summed over its pieces; ratio = baseline / new = fewer steps x "
-         f"cheaper step (core-s per step and DOF); levers = reference / new. Same R-curve, new against the "
+         f"cheaper step (core-s per step and DOF); levers = reference / new; at phi = 1: the new run's share of steps in "
+         f"history intervals at loading-rate multiplier 1 at both ends, and the ratio / that share, the most a higher "
+         f"phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column). Same R-curve, new against the "
          f"reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged over (0,30] d "
          f"and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the pointwise L2 "
          f"reported, not deciding; the baseline's R mean against the new one reported beside it (its model is not "
          f"today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
-         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | steps (baseline / "
+         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 (bound) | "
+         "steps (baseline / "
          "new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | broken rods (reference / new) "
          "| L2 | same R-curve | baseline's R mean (diff) | verdict |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     L += [table_line(r) for r in rows]
     L += ["", "Per run (pieces: solver processes of a resumed run; started: the first piece, UTC):", ""]
     for r in rows:
@@ -304,13 +331,20 @@ def pct(v) -> str:
     return fmt(v * 100 if v is not None else None, "+.2f") + "%"
 
 
+def unit_rate_cell(r: dict) -> str:
+    """The share of the new run's steps at phi = 1 and the ratio's bound from it, or n/a."""
+    share = r.get("new_unit_rate_share")
+    return f"{share:.0%} ({r['ratio_bound']:.2f})" if share else "n/a"
+
+
 def table_line(r: dict) -> str:
     """One case's line of the table."""
     if r.get("status") != "complete":
-        return f"| {r['case']} |" + " |" * 14 + f" {r['verdict']} |"
+        return f"| {r['case']} |" + " |" * 15 + f" {r['verdict']} |"
     dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
     return (f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
-            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {r['baseline_steps']} / "
+            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {unit_rate_cell(r)} | "
+            f"{r['baseline_steps']} / "
             f"{r['new_steps']} | {dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_reference'), '.4g')} "
             f"/ {fmt(r.get('R_mean_new'), '.4g')} ({pct(r.get('R_mean_rel'))}) | {pct(r.get('R_init_rel'))} | "
             f"{r.get('rods_reference')} / {r.get('rods_new')} | {fmt(r.get('rcurve_l2', math.nan) * 100, '.2f')}% | "

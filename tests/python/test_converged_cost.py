@@ -42,9 +42,12 @@ def test_stopped_continued_and_tabled(enamel, tmp_path):
     first = subprocess.Popen(harness(enamel, tmp_path), cwd=ROOT, env=env, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     t0 = time.monotonic()
-    while len([d for d in run_dirs(tmp_path) if (d / ".lock").exists()]) < 2 and time.monotonic() - t0 < 30:
+    # result.partial.h5 appears once the solver has set up and handles SIGINT (before, the signal ends it with
+    # nothing to keep, which a busy machine makes likely within a fixed delay)
+    while (len([d for d in run_dirs(tmp_path) if (d / "result.partial.h5").exists()]) < 2
+           and time.monotonic() - t0 < 120):
         time.sleep(0.2)
-    time.sleep(2.0)
+    time.sleep(1.0)
     first.send_signal(signal.SIGINT)           # forwarded: each solver writes its checkpoint and stops
     out, err = first.communicate(timeout=120)
     assert first.returncode == 130, (out, err)
@@ -70,6 +73,8 @@ def test_stopped_continued_and_tabled(enamel, tmp_path):
     assert row["same_rcurve"] == "True" and float(row["R_mean_rel"]) == 0.0 and float(row["R_init_rel"]) == 0.0
     assert float(row["range_hi"]) >= 10 and row["baseline_pieces"] == "2" and row["new_threads"] == "1"
     assert float(row["fewer_steps"]) == 1.0
+    # no adaptive rate: every step at phi = 1, so the ratio is its own bound
+    assert float(row["new_unit_rate_share"]) == 1.0 and float(row["ratio_bound"]) == float(row["ratio"])
     assert math.isclose(float(row["fewer_steps"]) * float(row["cheaper_step"]), float(row["ratio"]), rel_tol=1e-4)
     md = (tmp_path / "converged_cost.md").read_text()
     assert "a `ci`-preset check, not the converged table" in md and "1 thread a run" in md
@@ -127,8 +132,21 @@ def crafted_row(case, b_core, n_core, same):
     return row
 
 
+def test_unit_rate_share(tmp_path):
+    """Steps in history intervals with phi = 1 at both ends over all steps; None without the column."""
+    import h5py
+    path = tmp_path / "result.h5"
+    with h5py.File(path, "w") as f:
+        f["history/step"] = [0, 10, 20, 30, 40, 100]
+        f["history/rate_multiplier"] = [1.0, 1.0, 2.0, 2.0, 1.0, 1.0]
+    assert converged_cost.unit_rate_share(path) == pytest.approx((10 + 60) / 100)
+    with h5py.File(path, "w") as f:
+        f["history/step"] = [0, 10, 20]
+    assert converged_cost.unit_rate_share(path) is None
+
+
 def test_table_from_crafted_numbers(tmp_path):
-    rows = [crafted_row("a", 1376.0, 1376.0 / 2.9, True), crafted_row("b", 1376.0, 400.0, False),
+    rows = [dict(crafted_row("a", 1376.0, 1376.0 / 2.9, True), new_unit_rate_share=0.5, ratio_bound=5.8), crafted_row("b", 1376.0, 400.0, False),
             crafted_row("c", 1376.0, 1376.0 / 3.2, True), dict(case="d", status="incomplete", met=False,
                                                              verdict=converged_cost.verdict(math.nan, None)[1])]
     header = dict(date="2026-12-06 08:00", machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
@@ -140,6 +158,7 @@ def test_table_from_crafted_numbers(tmp_path):
     assert "| **2.90** |" in lines["a"] and "not met: ratio 2.90 < 3" in lines["a"]
     assert "| **3.44** |" in lines["b"] and "not met: not the same R-curve (R mean -2.5%)" in lines["b"]
     assert "| **3.20** |" in lines["c"] and lines["c"].rstrip().endswith("| True | 7.1 (-8.45%) | met |")
+    assert "| 50% (5.80) |" in lines["a"] and "| n/a |" in lines["b"]
     assert "| 2.64 |" in lines["a"]           # the levers' own ratio, reference / new: (1376 / 1.1) / (1376 / 2.9)
     assert "no comparison" in lines["d"]
     assert "not the converged table" not in md and "G = 10" in md and "c09beab" in md
