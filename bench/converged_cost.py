@@ -301,17 +301,16 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"(bench/converged_cost.py). Baseline: the build of {header['baseline']} (solver {header['baseline_git']}). "
          f"New: solver {header['new_git']}{header['new_sets']}. Reference: {header['reference']}. Core-seconds: the "
          f"solver process's CPU time (user + system) summed over its pieces; ratio = baseline / new = fewer steps x "
-         f"cheaper step (core-s per step and DOF); levers = reference / new; at phi = 1: the new run's share of steps in "
-         f"history intervals at loading-rate multiplier 1 at both ends, and the ratio / that share, the most a higher "
-         f"phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column). Same R-curve, new against the "
-         f"reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged over (0,30] d "
-         f"and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the pointwise L2 "
-         f"reported, not deciding; the baseline's R mean against the new one reported beside it (its model is not "
+         f"cheaper step (core-s per step and DOF); levers = reference / new; at phi = 1: the new run's share of "
+         f"steps in history intervals at loading-rate multiplier 1 at both ends, and the ratio / that share, the most "
+         f"a higher phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column). Same R-curve, new "
+         f"against the reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged "
+         f"over (0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
+         f"pointwise L2 reported, not deciding; the baseline's R mean against the new one reported beside it (its model is not "
          f"today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
-         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 (bound) | "
-         "steps (baseline / "
-         "new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | broken rods (reference / new) "
-         "| L2 | same R-curve | baseline's R mean (diff) | verdict |",
+         "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 "
+         "(bound) | steps (baseline / new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | "
+         "broken rods (reference / new) | L2 | same R-curve | baseline's R mean (diff) | verdict |",
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     L += [table_line(r) for r in rows]
     L += ["", "Per run (pieces: solver processes of a resumed run; started: the first piece, UTC):", ""]
