@@ -306,8 +306,8 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"a higher phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column). Same R-curve, new "
          f"against the reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged "
          f"over (0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
-         f"pointwise L2 reported, not deciding; the baseline's R mean against the new one reported beside it (its model is not "
-         f"today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
+         f"pointwise L2 reported, not deciding; the baseline's R mean against the new one reported beside it (its "
+         f"model is not today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
          "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 "
          "(bound) | steps (baseline / new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | "
          "broken rods (reference / new) | L2 | same R-curve | baseline's R mean (diff) | verdict |",
