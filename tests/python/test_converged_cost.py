@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 
+import h5py
 import pytest
 
 from conftest import ROOT
@@ -134,7 +135,6 @@ def crafted_row(case, b_core, n_core, same):
 
 def test_unit_rate_share(tmp_path):
     """Steps in history intervals with phi = 1 at both ends over all steps; None without the column."""
-    import h5py
     path = tmp_path / "result.h5"
     with h5py.File(path, "w") as f:
         f["history/step"] = [0, 10, 20, 30, 40, 100]
@@ -146,7 +146,8 @@ def test_unit_rate_share(tmp_path):
 
 
 def test_table_from_crafted_numbers(tmp_path):
-    rows = [dict(crafted_row("a", 1376.0, 1376.0 / 2.9, True), new_unit_rate_share=0.5, ratio_bound=5.8), crafted_row("b", 1376.0, 400.0, False),
+    rows = [dict(crafted_row("a", 1376.0, 1376.0 / 2.9, True), new_unit_rate_share=0.5, ratio_bound=5.8),
+            crafted_row("b", 1376.0, 400.0, False),
             crafted_row("c", 1376.0, 1376.0 / 3.2, True), dict(case="d", status="incomplete", met=False,
                                                              verdict=converged_cost.verdict(math.nan, None)[1])]
     header = dict(date="2026-12-06 08:00", machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
