@@ -80,3 +80,33 @@ def test_a_half_rate_twin_is_no_candidate_and_is_judged_against_its_run(tmp_path
         (tmp_path / f"r{i}.json").write_text(json.dumps(r))
     rows = [l for l in tip.twins_report().splitlines() if l.startswith("| r2 ")]
     assert len(rows) == 1 and "| r0 | 0.5 |" in rows[0] and rows[0].rstrip().endswith("| no |")
+
+
+def test_stage7_reads_the_rate_from_the_phase_averages(tmp_path, monkeypatch):
+    """Stage 7: the half rate's phase average against the preset rate's, by the measure (2 %), else against twice
+    the combined standard error of the phases' means; each twin is judged against its own phase's run."""
+    monkeypatch.setattr(tip, "DATA", tmp_path)
+
+    def write(levels_1, levels_half):
+        for f in tmp_path.glob("*.json"):
+            f.unlink()
+        for rate, levels in ((1.0, levels_1), (0.5, levels_half)):
+            for ph, level in zip(tip.PHASES, levels):
+                r = crafted(80, 9.0, "cut", ph, 3.0, level, True)
+                r["keys"]["rate_factor"] = rate
+                r.update(name=f"r{rate:g}_p{ph:g}", events=dict(first_break_da=2.0),
+                         statements=dict(mean_0_30=level, mean_5_25=level, i_kinks_first=True, ii_rising=True))
+                (tmp_path / f"{r['name']}.json").write_text(json.dumps(r))
+        return tip.phases_report()
+
+    same = write([6.0, 6.2, 6.1, 6.3], [6.05, 6.2, 6.1, 6.3])
+    assert "| 1 | average |" in same and "the same R-curve (2 %)" in same.splitlines()[-1]
+    noisy = write([5.0, 7.0, 5.2, 6.8], [5.4, 7.2, 5.6, 7.0])            # +5 %, the phases' spread ~1 R each
+    assert "within the phases' noise" in noisy.splitlines()[-1]
+    apart = write([6.0, 6.1, 6.0, 6.1], [6.6, 6.7, 6.6, 6.7])            # +10 %, spread 0.06
+    assert "beyond the phases' noise" in apart.splitlines()[-1]
+    rows = [l for l in tip.twins_report().splitlines() if l.startswith("| r0.5_p0.25 ")]
+    assert len(rows) == 1 and "| r1_p0.25 | 0.5 |" in rows[0]
+    (tmp_path / "r0.5_p0.5.json").unlink()
+    partial = tip.phases_report()
+    assert "| 0.5 | 0.5 | not recorded |" in partial and "rate is" not in partial and "| 0.5 | average |" not in partial

@@ -6,6 +6,7 @@
     python3 -m research.tip.tip candidates                                             # the rule applied, from data/
     python3 -m research.tip.tip run NAME ... --rate-factor 0.5                         # a half-rate twin (stage 5)
     python3 -m research.tip.tip twins                                                  # each twin against its run
+    python3 -m research.tip.tip phases                                                 # stage 7: phase averages
 
 A run goes to runs/tip/NAME (niced, one thread, checkpointed); its record to data/NAME.json: the case, the keys of
 the candidate, the metrics the rule reads (R_init, the (0,30] and (5,25] means, the first rod break and the kinks
@@ -172,21 +173,92 @@ def select(cands: list[dict]) -> tuple[dict | None, str]:
     return best, "none meets (i) and (ii): (iii) alone"
 
 
+def run_at(recs: list[dict], keys: dict, rate: float) -> dict | None:
+    """The record of the run with the same size, G, reading and phase as `keys`, at rate factor `rate`."""
+    return next((r for r in recs if rate_of(r) == rate and abs(r["keys"]["phase"] - keys["phase"]) < 1e-9
+                 and all(r["keys"][k] == keys[k] for k in ("size", "G", "reading"))), None)
+
+
 def twins_report() -> str:
-    """Each run at another rate_factor against the run of the same keys at the preset's rate, by the measure at
-    the rate-and-speed tolerance (metrics.same_rcurve, TOL_RATE_SPEED: 2 %)."""
+    """Each run at another rate_factor against the run of the same keys (phase included) at the preset's rate, by
+    the measure at the rate-and-speed tolerance (metrics.same_rcurve, TOL_RATE_SPEED: 2 %)."""
     recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
     lines = ["| twin | of | rate factor | mean (0,30] rel | R_init rel | rods | L2 | the same R-curve (2 %) |",
              "|" + "---|" * 8]
     for t in (r for r in recs if rate_of(r) != 1.0):
-        k = t["keys"]
-        base = members(recs, k["G"], k["size"], k["reading"]) if k["phase"] == 0 else None
+        base = run_at(recs, t["keys"], 1.0)
         if not base:
             lines.append(f"| {t['name']} | none recorded | {rate_of(t):g} | | | | | |")
             continue
-        c = metrics.same_rcurve(curve(base[0]), curve(t), metrics.TOL_RATE_SPEED)
-        lines.append(f"| {t['name']} | {base[0]['name']} | {rate_of(t):g} | {c.mean_rel:+.2%} | {c.init_rel:+.2%} | "
+        c = metrics.same_rcurve(curve(base), curve(t), metrics.TOL_RATE_SPEED)
+        lines.append(f"| {t['name']} | {base['name']} | {rate_of(t):g} | {c.mean_rel:+.2%} | {c.init_rel:+.2%} | "
                      f"{c.rods_a} / {c.rods_b} | {c.l2:.3f} | {'yes' if c.same else 'no'} |")
+    return "\n".join(lines) + "\n"
+
+
+STAGE7 = dict(size=80, G=9.0, reading="cut")   # README, stage 7: phases k/4 at rate factors 1 and 0.5
+STAGE7_RATES = (1.0, 0.5)
+
+
+def phase_set(recs: list[dict], rate: float) -> list[dict | None]:
+    """Stage 7's runs at one rate, by phase k/4 (None where not recorded)."""
+    return [run_at(recs, dict(STAGE7, phase=ph), rate) for ph in PHASES]
+
+
+def phase_summary(group: list[dict]) -> dict:
+    """The phase average of complete group (metrics.phase_average) and the spread of the phases' (0,30] means m_k:
+    s their standard deviation, se = s / sqrt(N) the standard error of their mean."""
+    avg = metrics.phase_average([curve(r) for r in group]).curve
+    m = np.array([metrics.advance_mean(curve(r), 0, 30) for r in group])
+    s = float(np.std(m, ddof=1))
+    return dict(curve=avg, means=m, s=s, se=s / math.sqrt(len(m)), mean=metrics.advance_mean(avg, 0, 30))
+
+
+def phase_rows(group: list[dict | None], rate: float) -> list[str]:
+    lines = []
+    for ph, r in zip(PHASES, group):
+        if r is None:
+            lines.append(f"| {rate:g} | {ph:g} | not recorded | | | | | | |")
+            continue
+        st, ev = r["statements"], r["events"]
+        lines.append(f"| {rate:g} | {ph:g} | {r['name']} | {r['R_init']:.3f} | {st['mean_0_30']:.3f} | "
+                     f"{st['mean_5_25']:.2f} | {ev['first_break_da']:.2f} | {r['broken_rods']} | "
+                     f"{'holds' if st['i_kinks_first'] else 'fails'} / {'holds' if st['ii_rising'] else 'fails'} |")
+    if all(r is not None for r in group):
+        p = phase_summary(group)
+        lines.append(f"| {rate:g} | average | | {float(p['curve'].R[0]):.3f} | {p['mean']:.3f} | "
+                     f"{metrics.advance_mean(p['curve'], 5, 25):.2f} | | | |")
+        lines.append(f"| {rate:g} | spread | m_k {p['means'].min():.3f} to {p['means'].max():.3f} | | "
+                     f"s {p['s']:.3f} ({p['s'] / p['mean']:.1%}), se {p['se']:.3f} | | | | |")
+    return lines
+
+
+def rate_reading(one: dict, half: dict) -> str:
+    """README stage 7, reading 2: the two phase averages by the measure (2 %), else within 2 sqrt(se1^2 + se2^2)."""
+    c = metrics.same_rcurve(one["curve"], half["curve"], metrics.TOL_RATE_SPEED)
+    bound = 2 * math.hypot(one["se"], half["se"])
+    diff = half["mean"] - one["mean"]
+    head = (f"half rate against the preset's rate, phase averages: mean (0,30] {c.mean_rel:+.2%}, R_init "
+            f"{c.init_rel:+.2%}, rods {c.rods_a} / {c.rods_b}; difference {diff:+.3f} against 2 sqrt(se_1^2 + "
+            f"se_0.5^2) = {bound:.3f}: ")
+    if c.same:
+        return head + "the same R-curve (2 %): the half rate holds for the phase-averaged R-curve."
+    if abs(diff) <= bound:
+        return head + "not the same (2 %), but within the phases' noise: not decidable with 4 phases."
+    return head + "not the same, and beyond the phases' noise: the rate is not converged at the preset."
+
+
+def phases_report() -> str:
+    """Stage 7 (README): each phase's run at both rates, the phase averages and their spread, and the rate's
+    reading once both sets are complete."""
+    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    lines = ["| rate factor | phase | run | R_init | mean (0,30] | (5,25] | first break (d) | rods | (i) / (ii) |",
+             "|" + "---|" * 9]
+    groups = {rate: phase_set(recs, rate) for rate in STAGE7_RATES}
+    for rate in STAGE7_RATES:
+        lines += phase_rows(groups[rate], rate)
+    if all(r is not None for g in groups.values() for r in g):
+        lines += ["", rate_reading(*(phase_summary(groups[rate]) for rate in STAGE7_RATES))]
     return "\n".join(lines) + "\n"
 
 
@@ -222,9 +294,11 @@ def main(argv=None) -> int:
     sub.add_parser("report", help="the runs table from data/")
     sub.add_parser("candidates", help="the candidates with both sizes recorded, judged by the rule, from data/")
     sub.add_parser("twins", help="each run at another rate_factor against its run at the preset's rate")
+    sub.add_parser("phases", help="stage 7: the phase averages at rate factors 1 and 0.5, from data/")
     a = ap.parse_args(argv)
-    if a.cmd in ("report", "candidates", "twins"):
-        print(dict(report=report, candidates=candidates_report, twins=twins_report)[a.cmd](), end="")
+    if a.cmd in ("report", "candidates", "twins", "phases"):
+        print(dict(report=report, candidates=candidates_report, twins=twins_report, phases=phases_report)[a.cmd](),
+              end="")
         return 0
     out = RUNS / a.name
     if a.cmd == "record":
