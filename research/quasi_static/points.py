@@ -43,19 +43,19 @@ def row_ratios(h) -> np.ndarray:
     return np.where(past, np.maximum(beyond, whole), 0.0)
 
 
-def point_ratios(h, da_points: np.ndarray) -> np.ndarray:
-    """The ratio at the first history row whose crack advance reached each R point's."""
-    ratio, reached = row_ratios(h), np.maximum.accumulate(h["da_over_d"][:])
+def point_ratios(h, da_points: np.ndarray, ratios: np.ndarray) -> np.ndarray:
+    """The ratio (row_ratios of h) at the first history row whose crack advance reached each R point's."""
+    reached = np.maximum.accumulate(h["da_over_d"][:])
     idx = np.minimum(np.searchsorted(reached, da_points, side="left"), len(reached) - 1)
-    return ratio[idx]
+    return ratios[idx]
 
 
 def run_row(result_h5: pathlib.Path) -> dict:
     r = results.load_result(result_h5)
     with h5py.File(result_h5, "r") as f:
         h = f["history"]
-        ratios = point_ratios(h, r.da)
         every = row_ratios(h)
+        ratios = point_ratios(h, r.da, every)
     largest, recorded = float(every.max()), float(r.meta.get("max_quasi_static_ratio", np.nan))
     if not np.isclose(float(every[:-1].max()), recorded, rtol=1e-9, atol=1e-12):   # the solver's leaves out the last row
         raise ValueError(f"{result_h5}: largest ratio {every[:-1].max()} is not the solver's {recorded}")
@@ -84,8 +84,8 @@ def write(runs: pathlib.Path, out: pathlib.Path = CSV) -> list[dict]:
 
 def report(path: pathlib.Path = CSV) -> str:
     rows = list(csv.DictReader(open(path)))
-    lines = ["| run | R points in (0, 30] d | warned | advance at warned points | mean (0, 30] | through unwarned points | difference | largest ratio |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| run | R points in (0, 30] d | warned | advance at warned points | mean (0, 30] | through unwarned points "
+             "| difference | largest ratio |", "|---|---|---|---|---|---|---|---|"]
     for w in rows:
         lines.append(f"| {w['run']} | {w['points']} | {w['warned']} | {100 * float(w['advance_warned']):.0f} % | "
                      f"{float(w['mean']):.3f} | {float(w['mean_unwarned']):.3f} | {100 * float(w['rel']):+.1f} % | "

@@ -88,7 +88,7 @@ def record(name: str, out: pathlib.Path, keys: dict | None = None) -> dict:
 
 
 def report() -> str:
-    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    recs = load_records()
     lines = ["| run | size | G | reading | phase | status | R_init | mean (0,30] | mean (5,25] | first break (d) |"
              " Delta_a before it | kinks off the plane | threshold (d) | (i) | (ii) | wall (h) |", "|" + "---|" * 16]
     for r in recs:
@@ -117,11 +117,21 @@ def curve(rec: dict) -> metrics.RCurve:
     return metrics.RCurve.of(rec["da"], rec["R"], broken_rods=rec["broken_rods"])
 
 
+def load_records() -> list[dict]:
+    """Every run's record in data/, by name."""
+    return [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+
+
+def run_at(recs: list[dict], keys: dict, rate: float) -> dict | None:
+    """The record of the run with the same size, G, reading and phase as `keys`, at rate factor `rate`."""
+    return next((r for r in recs if rate_of(r) == rate and abs(r["keys"]["phase"] - keys["phase"]) < 1e-9
+                 and all(r["keys"][k] == keys[k] for k in ("size", "G", "reading"))), None)
+
+
 def members(recs: list[dict], G: float, size: int, reading: str) -> list[dict] | None:
     """The records a candidate reads at one size: its run, or for `averaged` the intact run and the phases."""
     def find(rd, ph):
-        return next((r for r in recs if r["keys"]["size"] == size and r["keys"]["G"] == G and rate_of(r) == 1.0
-                     and r["keys"]["reading"] == rd and abs(r["keys"]["phase"] - ph) < 1e-9), None)
+        return run_at(recs, dict(size=size, G=G, reading=rd, phase=ph), 1.0)
     got = [find(reading, 0.0)] if reading != "averaged" else [find("intact", ph) for ph in PHASES]
     return None if any(r is None for r in got) else got
 
@@ -173,16 +183,10 @@ def select(cands: list[dict]) -> tuple[dict | None, str]:
     return best, "none meets (i) and (ii): (iii) alone"
 
 
-def run_at(recs: list[dict], keys: dict, rate: float) -> dict | None:
-    """The record of the run with the same size, G, reading and phase as `keys`, at rate factor `rate`."""
-    return next((r for r in recs if rate_of(r) == rate and abs(r["keys"]["phase"] - keys["phase"]) < 1e-9
-                 and all(r["keys"][k] == keys[k] for k in ("size", "G", "reading"))), None)
-
-
 def twins_report() -> str:
     """Each run at another rate_factor against the run of the same keys (phase included) at the preset's rate, by
     the measure at the rate-and-speed tolerance (metrics.same_rcurve, TOL_RATE_SPEED: 2 %)."""
-    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    recs = load_records()
     lines = ["| twin | of | rate factor | mean (0,30] rel | R_init rel | rods | L2 | the same R-curve (2 %) |",
              "|" + "---|" * 8]
     for t in (r for r in recs if rate_of(r) != 1.0):
@@ -214,7 +218,8 @@ def phase_summary(group: list[dict]) -> dict:
     return dict(curve=avg, means=m, s=s, se=s / math.sqrt(len(m)), mean=metrics.advance_mean(avg, 0, 30))
 
 
-def phase_rows(group: list[dict | None], rate: float) -> list[str]:
+def phase_rows(group: list[dict | None], rate: float, summary: dict | None) -> list[str]:
+    """Each phase's row at one rate, then (summary: phase_summary of a complete group) the average and spread."""
     lines = []
     for ph, r in zip(PHASES, group):
         if r is None:
@@ -224,8 +229,8 @@ def phase_rows(group: list[dict | None], rate: float) -> list[str]:
         lines.append(f"| {rate:g} | {ph:g} | {r['name']} | {r['R_init']:.3f} | {st['mean_0_30']:.3f} | "
                      f"{st['mean_5_25']:.2f} | {ev['first_break_da']:.2f} | {r['broken_rods']} | "
                      f"{'holds' if st['i_kinks_first'] else 'fails'} / {'holds' if st['ii_rising'] else 'fails'} |")
-    if all(r is not None for r in group):
-        p = phase_summary(group)
+    if summary is not None:
+        p = summary
         lines.append(f"| {rate:g} | average | | {float(p['curve'].R[0]):.3f} | {p['mean']:.3f} | "
                      f"{metrics.advance_mean(p['curve'], 5, 25):.2f} | | | |")
         lines.append(f"| {rate:g} | spread | m_k {p['means'].min():.3f} to {p['means'].max():.3f} | | "
@@ -251,19 +256,20 @@ def rate_reading(one: dict, half: dict) -> str:
 def phases_report() -> str:
     """Stage 7 (README): each phase's run at both rates, the phase averages and their spread, and the rate's
     reading once both sets are complete."""
-    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    recs = load_records()
     lines = ["| rate factor | phase | run | R_init | mean (0,30] | (5,25] | first break (d) | rods | (i) / (ii) |",
              "|" + "---|" * 9]
     groups = {rate: phase_set(recs, rate) for rate in STAGE7_RATES}
+    summaries = {rate: phase_summary(g) if None not in g else None for rate, g in groups.items()}
     for rate in STAGE7_RATES:
-        lines += phase_rows(groups[rate], rate)
-    if all(r is not None for g in groups.values() for r in g):
-        lines += ["", rate_reading(*(phase_summary(groups[rate]) for rate in STAGE7_RATES))]
+        lines += phase_rows(groups[rate], rate, summaries[rate])
+    if None not in summaries.values():
+        lines += ["", rate_reading(*(summaries[rate] for rate in STAGE7_RATES))]
     return "\n".join(lines) + "\n"
 
 
 def candidates_report() -> str:
-    recs = [json.loads(p.read_text()) for p in sorted(DATA.glob("*.json"))]
+    recs = load_records()
     cands = candidates(recs)
     lines = ["| G | reading | 80 vs 100 d: mean (0,30] | R_init | converged | (i) both | (ii) both | level (5,25] 80 / 100 "
              "| level of the pair |", "|" + "---|" * 9]
