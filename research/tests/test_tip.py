@@ -110,3 +110,35 @@ def test_stage7_reads_the_rate_from_the_phase_averages(tmp_path, monkeypatch):
     (tmp_path / "r0.5_p0.5.json").unlink()
     partial = tip.phases_report()
     assert "| 0.5 | 0.5 | not recorded |" in partial and "rate is" not in partial and "| 0.5 | average |" not in partial
+
+
+def test_stage8_decides_the_rate_by_the_paired_differences(tmp_path, monkeypatch):
+    """Stage 8: the phase averages by the measure (2 %) hold; else the paired differences d_k of the same phases
+    decide: |dbar| > 2 se_d fails, else not decided with the bound |dbar| + 2 se_d; the unpaired test beside."""
+    monkeypatch.setattr(tip, "DATA", tmp_path)
+
+    def write(levels_1, levels_half):
+        for f in tmp_path.glob("*.json"):
+            f.unlink()
+        for rate, levels in ((1.0, levels_1), (0.5, levels_half)):
+            for ph, level in zip(tip.STAGE8_PHASES, levels):
+                r = crafted(80, 9.0, "cut", ph, 3.0, level, True)
+                r["keys"]["rate_factor"] = rate
+                r.update(name=f"r{rate:g}_p{ph:.3f}", events=dict(first_break_da=None),
+                         statements=dict(mean_0_30=level, mean_5_25=level, i_kinks_first=True, ii_rising=True))
+                (tmp_path / f"{r['name']}.json").write_text(json.dumps(r))
+        return tip.phases_report(tip.STAGE8_PHASES)
+
+    base = [5.0, 7.0, 5.2, 6.8, 5.1, 6.9, 5.3, 6.7]                          # one configuration's noise ~1 R
+    same = write(base, [x + 0.05 for x in base])
+    assert "| 0.5 | 0.875 |" in same and "holds for the phase-averaged" in same.splitlines()[-1]
+    shifted = write(base, [x + 0.3 + 0.01 * (-1) ** k for k, x in enumerate(base)])   # +5 %, each phase alike
+    last = shifted.splitlines()[-1]
+    assert "the paired difference is resolved" in last and "dbar +0.297" in last     # (0,30] means: 0.5 d at R_init
+    assert "within the phases' noise" in shifted        # the unpaired test cannot see it; the paired one does
+    scattered = write(base, [x + (0.9 if k % 2 else -0.3) for k, x in enumerate(base)])   # dbar 0.3, s_d 0.64
+    last = scattered.splitlines()[-1]
+    assert "not decided at 8 phases" in last and "at most 0.747" in last   # 0.297 + 2 x 0.636 / sqrt 8
+    (tmp_path / "r0.5_p0.375.json").unlink()
+    partial = tip.phases_report(tip.STAGE8_PHASES)
+    assert "| 0.5 | 0.375 | not recorded |" in partial and "paired" not in partial

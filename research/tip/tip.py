@@ -7,6 +7,7 @@
     python3 -m research.tip.tip run NAME ... --rate-factor 0.5                         # a half-rate twin (stage 5)
     python3 -m research.tip.tip twins                                                  # each twin against its run
     python3 -m research.tip.tip phases                                                 # stage 7: phase averages
+    python3 -m research.tip.tip phases --stage 8                                       # stage 8: 8 phases, paired
 
 A run goes to runs/tip/NAME (niced, one thread, checkpointed); its record to data/NAME.json: the case, the keys of
 the candidate, the metrics the rule reads (R_init, the (0,30] and (5,25] means, the first rod break and the kinks
@@ -200,13 +201,14 @@ def twins_report() -> str:
     return "\n".join(lines) + "\n"
 
 
-STAGE7 = dict(size=80, G=9.0, reading="cut")   # README, stage 7: phases k/4 at rate factors 1 and 0.5
+STAGE7 = dict(size=80, G=9.0, reading="cut")   # README, stages 7 and 8: phases k/N at rate factors 1 and 0.5
 STAGE7_RATES = (1.0, 0.5)
+STAGE8_PHASES = tuple(k / 8 for k in range(8))  # README, stage 8: the even phases are stage 7's
 
 
-def phase_set(recs: list[dict], rate: float) -> list[dict | None]:
-    """Stage 7's runs at one rate, by phase k/4 (None where not recorded)."""
-    return [run_at(recs, dict(STAGE7, phase=ph), rate) for ph in PHASES]
+def phase_set(recs: list[dict], rate: float, phases: tuple = PHASES) -> list[dict | None]:
+    """The runs of stages 7 and 8 at one rate, by phase (None where not recorded)."""
+    return [run_at(recs, dict(STAGE7, phase=ph), rate) for ph in phases]
 
 
 def phase_summary(group: list[dict]) -> dict:
@@ -218,16 +220,17 @@ def phase_summary(group: list[dict]) -> dict:
     return dict(curve=avg, means=m, s=s, se=s / math.sqrt(len(m)), mean=metrics.advance_mean(avg, 0, 30))
 
 
-def phase_rows(group: list[dict | None], rate: float, summary: dict | None) -> list[str]:
+def phase_rows(group: list[dict | None], rate: float, summary: dict | None, phases: tuple = PHASES) -> list[str]:
     """Each phase's row at one rate, then (summary: phase_summary of a complete group) the average and spread."""
     lines = []
-    for ph, r in zip(PHASES, group):
+    for ph, r in zip(phases, group):
         if r is None:
             lines.append(f"| {rate:g} | {ph:g} | not recorded | | | | | | |")
             continue
         st, ev = r["statements"], r["events"]
+        fb = "none" if ev["first_break_da"] is None else f"{ev['first_break_da']:.2f}"
         lines.append(f"| {rate:g} | {ph:g} | {r['name']} | {r['R_init']:.3f} | {st['mean_0_30']:.3f} | "
-                     f"{st['mean_5_25']:.2f} | {ev['first_break_da']:.2f} | {r['broken_rods']} | "
+                     f"{st['mean_5_25']:.2f} | {fb} | {r['broken_rods']} | "
                      f"{'holds' if st['i_kinks_first'] else 'fails'} / {'holds' if st['ii_rising'] else 'fails'} |")
     if summary is not None:
         p = summary
@@ -249,22 +252,48 @@ def rate_reading(one: dict, half: dict) -> str:
     if c.same:
         return head + "the same R-curve (2 %): the half rate holds for the phase-averaged R-curve."
     if abs(diff) <= bound:
-        return head + "not the same (2 %), but within the phases' noise: not decidable with 4 phases."
+        return head + f"not the same (2 %), but within the phases' noise: not decidable with {len(one['means'])} phases."
     return head + "not the same, and beyond the phases' noise: the rate is not converged at the preset."
 
 
-def phases_report() -> str:
-    """Stage 7 (README): each phase's run at both rates, the phase averages and their spread, and the rate's
-    reading once both sets are complete."""
+def paired_reading(one: dict, half: dict) -> str:
+    """README stage 8, reading 2: the two phase averages by the measure (2 %): holds; else the paired differences
+    d_k = m'_k - m_k of the same phases: |dbar| > 2 se_d (se_d = s_d / sqrt N) fails, else not decided, with the
+    bound |dbar| + 2 se_d on the rate's effect."""
+    c = metrics.same_rcurve(one["curve"], half["curve"], metrics.TOL_RATE_SPEED)
+    d = half["means"] - one["means"]
+    dbar, s_d = float(d.mean()), float(np.std(d, ddof=1))
+    se_d = s_d / math.sqrt(len(d))
+    head = (f"paired: d_k = m'_k - m_k over {len(d)} phases: dbar {dbar:+.3f} ({dbar / one['mean']:+.2%} of the "
+            f"rate-1 average), s_d {s_d:.3f}, se_d {se_d:.3f}, 2 se_d {2 * se_d:.3f}; phase averages: mean (0,30] "
+            f"{c.mean_rel:+.2%}, R_init {c.init_rel:+.2%}: ")
+    if c.same:
+        return head + "the same R-curve (2 %): the half rate holds for the phase-averaged R-curve."
+    if abs(dbar) > 2 * se_d:
+        return head + ("not the same (2 %), and the paired difference is resolved (|dbar| > 2 se_d): the rate is "
+                       "not converged at the preset.")
+    bound = abs(dbar) + 2 * se_d
+    return head + (f"not the same (2 %), and the paired difference is not resolved (|dbar| <= 2 se_d): not decided "
+                   f"at {len(d)} phases; the rate's effect is at most {bound:.3f} ({bound / one['mean']:.2%}).")
+
+
+def phases_report(phases: tuple = PHASES) -> str:
+    """Stage 7 (phases k/4) or stage 8 (phases k/8; README): each phase's run at both rates, the phase averages and
+    their spread, and the rate's readings once both sets are complete (stage 8: the paired one deciding, the
+    unpaired one of stage 7 beside it)."""
     recs = load_records()
     lines = ["| rate factor | phase | run | R_init | mean (0,30] | (5,25] | first break (d) | rods | (i) / (ii) |",
              "|" + "---|" * 9]
-    groups = {rate: phase_set(recs, rate) for rate in STAGE7_RATES}
+    groups = {rate: phase_set(recs, rate, phases) for rate in STAGE7_RATES}
     summaries = {rate: phase_summary(g) if None not in g else None for rate, g in groups.items()}
     for rate in STAGE7_RATES:
-        lines += phase_rows(groups[rate], rate, summaries[rate])
+        lines += phase_rows(groups[rate], rate, summaries[rate], phases)
     if None not in summaries.values():
-        lines += ["", rate_reading(*(summaries[rate] for rate in STAGE7_RATES))]
+        pair = [summaries[rate] for rate in STAGE7_RATES]
+        if phases == PHASES:
+            lines += ["", rate_reading(*pair)]
+        else:
+            lines += ["", "unpaired (beside, not deciding): " + rate_reading(*pair), "", paired_reading(*pair)]
     return "\n".join(lines) + "\n"
 
 
@@ -300,11 +329,14 @@ def main(argv=None) -> int:
     sub.add_parser("report", help="the runs table from data/")
     sub.add_parser("candidates", help="the candidates with both sizes recorded, judged by the rule, from data/")
     sub.add_parser("twins", help="each run at another rate_factor against its run at the preset's rate")
-    sub.add_parser("phases", help="stage 7: the phase averages at rate factors 1 and 0.5, from data/")
+    ph = sub.add_parser("phases", help="stages 7 and 8: the phase averages at rate factors 1 and 0.5, from data/")
+    ph.add_argument("--stage", type=int, choices=(7, 8), default=7, help="7: phases k/4 (default); 8: phases k/8")
     a = ap.parse_args(argv)
     if a.cmd in ("report", "candidates", "twins", "phases"):
-        print(dict(report=report, candidates=candidates_report, twins=twins_report, phases=phases_report)[a.cmd](),
-              end="")
+        if a.cmd == "phases":
+            print(phases_report(PHASES if a.stage == 7 else STAGE8_PHASES), end="")
+            return 0
+        print(dict(report=report, candidates=candidates_report, twins=twins_report)[a.cmd](), end="")
         return 0
     out = RUNS / a.name
     if a.cmd == "record":
