@@ -252,7 +252,8 @@ def rate_reading(one: dict, half: dict) -> str:
     if c.same:
         return head + "the same R-curve (2 %): the half rate holds for the phase-averaged R-curve."
     if abs(diff) <= bound:
-        return head + f"not the same (2 %), but within the phases' noise: not decidable with {len(one['means'])} phases."
+        n = len(one["means"])
+        return head + f"not the same (2 %), but within the phases' noise: not decidable with {n} phases."
     return head + "not the same, and beyond the phases' noise: the rate is not converged at the preset."
 
 
