@@ -321,8 +321,7 @@ class RunLoop {
       rec_.warnings.push_back(fmt("energy balance error %.3g at step %.0f above %.2g", r.balanceError, s.step,
                                   kBalanceWarn));
     }
-    rec_.maxKineticRatio = std::max(rec_.maxKineticRatio, kineticRatio);
-    warnIfNotQuasiStatic(r);
+    noteQuasiStatic(r);
     // A reduced far field holds only while the inelastic zone stays inside the full band: its lumped interfaces
     // cannot soften apart, and its rod elements stand for m slices each (far_field_rod_breaks = allow lets
     // them break whole, with a warning; interfaces past delta0 there always stop the run).
@@ -358,6 +357,13 @@ class RunLoop {
                                   r.inelasticReach, s.step, s.crackAdvance, kEdgeWarnDistance, halfHeight));
     }
     return true;
+  }
+
+  /// A row's kinetic ratios into the run's maxima and its quasi-static warning: every row the loop checks, and the
+  /// stop's own row (finish).
+  void noteQuasiStatic(const Measurement& r) {
+    rec_.maxKineticRatio = std::max(rec_.maxKineticRatio, kineticRatioOf(r));
+    warnIfNotQuasiStatic(r);
   }
 
   /// The quasi-static warning, once: quasiStaticRatio above kKineticWarn at any row past the elastic start, whether
@@ -467,12 +473,14 @@ class RunLoop {
     if (opt_.checkpointIntervalSeconds > 0 && wall() - lastCheckpoint_ > opt_.checkpointIntervalSeconds) checkpoint();
   }
 
-  /// The last history row and frame, the result file under the name of its status (the partial one removed),
+  /// The last history row (its kinetic ratios noted as the loop's rows are) and frame, the result file under the name of its status (the partial one removed),
   /// and the checkpoint removed when the run completed.
   RunRecord finish() {
     if (opt_.progress && tty_) std::fprintf(stderr, "\n");
-    if (rec_.status != RunStatus::failed || rec_.history.empty() || rec_.history.back().step != sim_.state.step)
+    if (rec_.status != RunStatus::failed || rec_.history.empty() || rec_.history.back().step != sim_.state.step) {
       rec_.history.push_back(sim_.measure());
+      noteQuasiStatic(rec_.history.back());
+    }
     if (rec_.status == RunStatus::completed) {  // the steps since the last checked row: a run blown up there is no result
       const std::string blowUp = blowUpCheck(rec_.history.back(), kineticRatioOf(rec_.history.back()), guard_);
       if (!blowUp.empty()) fail(blowUp);

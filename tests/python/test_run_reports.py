@@ -43,6 +43,23 @@ def test_a_run_far_from_quasi_static_is_warned_though_its_crack_never_grows(run,
     assert "warning: kinetic energy beyond the loading's motion / strain energy" in r.stderr
 
 
+def test_the_stop_row_counts_in_the_quasi_static_maximum(run, tmp_path):
+    # The fast run above stopped at U = 23.8 d: its stop (step 1654, between two history rows) falls where the
+    # ratio beyond the loading's motion is larger than at any row before it (1.5533 against 1.5526, measured
+    # 2026-12-07); the run's maximum must include that row, as the loop's rows are included.
+    out = tmp_path / "stop"
+    r = run("run", PAPER_CASES / f"{THETA30}.toml", "--preset", "ci", "--out", out, "--quiet",
+            "--set", "rate_factor=500", "--set", "stop_u_over_d=23.8", "--set", "threads=1",
+            "--set", "Gamma_k_over_sigma0sq=10", "--set", 'crisscross_at_tip="intact"')
+    assert r.returncode == 0, r.stderr
+    with h5py.File(out / "result.h5", "r") as f:
+        meta, h = f["meta"].attrs, f["history"]
+        elastic_start = (h["inelastic_interfaces"][:] > 0) | (h["broken_rod_elements"][:] > 0)
+        ratio = np.where(elastic_start, over_strain(h, "kinetic_energy_beyond_loading"), 0)
+        assert h["da_over_d"][-1] == 0 and ratio[-1] > ratio[:-1].max(), "the stop row is not the largest: not the case"
+        assert np.isclose(meta["max_quasi_static_ratio"], ratio[-1], rtol=1e-12)
+
+
 def test_ci_theta30_is_not_newly_warned_and_its_balance_holds_from_the_first_row(ci_run):
     with h5py.File(ci_run(THETA30), "r") as f:
         meta, h = f["meta"].attrs, f["history"]
@@ -54,7 +71,9 @@ def test_ci_theta30_is_not_newly_warned_and_its_balance_holds_from_the_first_row
         assert pre.any() and not pre.all()
         assert beyond[pre].max() < KINETIC_WARN
         ratio = np.maximum(np.where(elastic_start, beyond, 0), np.where(da > 0, over_strain(h, "kinetic_energy"), 0))
-        assert np.isclose(meta["max_quasi_static_ratio"], ratio[:-1].max(), rtol=1e-12)   # the rows checked in the loop
+        assert np.isclose(meta["max_quasi_static_ratio"], ratio.max(), rtol=1e-12)   # every row, the stop's too
+        growing = np.where(da > 0, over_strain(h, "kinetic_energy"), 0)
+        assert np.isclose(meta["max_kinetic_over_strain_while_growing"], growing.max(), rtol=1e-12)
         for w in meta["warnings"].splitlines():   # a quasi-static warning names a row where the crack had grown
             if "not quasi-static" in w:
                 at = int(re.search(r"at step (\d+)", w).group(1))
