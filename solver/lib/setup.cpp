@@ -1,4 +1,5 @@
 #include "setup.hpp"
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <cmath>
@@ -206,14 +207,23 @@ State stateAtRest(const Model& m, const Operators& ops) {
   return s;
 }
 
+/// The BLAS's own thread count, where the BLAS linked at run time has one (OpenBLAS's pthread build, Debian's
+/// default, starts one thread per core whatever OpenMP is told): CHOLMOD's factorizations and solves use it.
+static void setBlasThreadCount(int n) {
+  using SetThreads = void (*)(int);
+  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(n);
+}
+
 void setThreadCount(const CaseParams& p, int numDofs) {
 #ifdef _OPENMP
-  omp_set_num_threads(p.threads > 0 ? static_cast<int>(p.threads)
-                                    : std::max(1, std::min(omp_get_num_procs(), numDofs / 30000)));
+  const int n = p.threads > 0 ? static_cast<int>(p.threads)
+                              : std::max(1, std::min(omp_get_num_procs(), numDofs / 30000));
+  omp_set_num_threads(n);
 #else
-  (void)p;
   (void)numDofs;
+  const int n = p.threads > 0 ? static_cast<int>(p.threads) : 1;
 #endif
+  setBlasThreadCount(n);
 }
 
 double measureTransverseModulus(const CaseParams& p, double* blockStrain) {
