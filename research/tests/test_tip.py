@@ -82,21 +82,27 @@ def test_a_half_rate_twin_is_no_candidate_and_is_judged_against_its_run(tmp_path
     assert len(rows) == 1 and "| r0 | 0.5 |" in rows[0] and rows[0].rstrip().endswith("| no |")
 
 
+def write_phase_records(folder, phases, levels_1, levels_half):
+    """Crafted records of the phase runs at rate factors 1 and 0.5 in `folder` (the ones there before removed),
+    named r<rate>_p<phase>, each flat at its level."""
+    for f in folder.glob("*.json"):
+        f.unlink()
+    for rate, levels in ((1.0, levels_1), (0.5, levels_half)):
+        for ph, level in zip(phases, levels):
+            r = crafted(80, 9.0, "cut", ph, 3.0, level, True)
+            r["keys"]["rate_factor"] = rate
+            r.update(name=f"r{rate:g}_p{ph:g}", events=dict(first_break_da=2.0),
+                     statements=dict(mean_0_30=level, mean_5_25=level, i_kinks_first=True, ii_rising=True))
+            (folder / f"{r['name']}.json").write_text(json.dumps(r))
+
+
 def test_stage7_reads_the_rate_from_the_phase_averages(tmp_path, monkeypatch):
     """Stage 7: the half rate's phase average against the preset rate's, by the measure (2 %), else against twice
     the combined standard error of the phases' means; each twin is judged against its own phase's run."""
     monkeypatch.setattr(tip, "DATA", tmp_path)
 
     def write(levels_1, levels_half):
-        for f in tmp_path.glob("*.json"):
-            f.unlink()
-        for rate, levels in ((1.0, levels_1), (0.5, levels_half)):
-            for ph, level in zip(tip.PHASES, levels):
-                r = crafted(80, 9.0, "cut", ph, 3.0, level, True)
-                r["keys"]["rate_factor"] = rate
-                r.update(name=f"r{rate:g}_p{ph:g}", events=dict(first_break_da=2.0),
-                         statements=dict(mean_0_30=level, mean_5_25=level, i_kinks_first=True, ii_rising=True))
-                (tmp_path / f"{r['name']}.json").write_text(json.dumps(r))
+        write_phase_records(tmp_path, tip.PHASES, levels_1, levels_half)
         return tip.phases_report()
 
     same = write([6.0, 6.2, 6.1, 6.3], [6.05, 6.2, 6.1, 6.3])
@@ -118,15 +124,7 @@ def test_stage8_decides_the_rate_by_the_paired_differences(tmp_path, monkeypatch
     monkeypatch.setattr(tip, "DATA", tmp_path)
 
     def write(levels_1, levels_half):
-        for f in tmp_path.glob("*.json"):
-            f.unlink()
-        for rate, levels in ((1.0, levels_1), (0.5, levels_half)):
-            for ph, level in zip(tip.STAGE8_PHASES, levels):
-                r = crafted(80, 9.0, "cut", ph, 3.0, level, True)
-                r["keys"]["rate_factor"] = rate
-                r.update(name=f"r{rate:g}_p{ph:.3f}", events=dict(first_break_da=None),
-                         statements=dict(mean_0_30=level, mean_5_25=level, i_kinks_first=True, ii_rising=True))
-                (tmp_path / f"{r['name']}.json").write_text(json.dumps(r))
+        write_phase_records(tmp_path, tip.STAGE8_PHASES, levels_1, levels_half)
         return tip.phases_report(tip.STAGE8_PHASES)
 
     base = [5.0, 7.0, 5.2, 6.8, 5.1, 6.9, 5.3, 6.7]                          # one configuration's noise ~1 R

@@ -21,15 +21,21 @@ def over_strain(h, name):
     return np.where(strain > 0, h[name][:] / np.where(strain > 0, strain, 1), 0.0)
 
 
+def fast_run(run, out, stop_u):
+    """theta30 at the ci preset and 500 times its loading rate, stopped at U = stop_u d (G = 10, the intact tip)."""
+    r = run("run", PAPER_CASES / f"{THETA30}.toml", "--preset", "ci", "--out", out, "--quiet",
+            "--set", "rate_factor=500", "--set", f"stop_u_over_d={stop_u}", "--set", "threads=1",
+            "--set", "Gamma_k_over_sigma0sq=10", "--set", 'crisscross_at_tip="intact"')
+    assert r.returncode == 0, r.stderr
+    return r
+
+
 def test_a_run_far_from_quasi_static_is_warned_though_its_crack_never_grows(run, tmp_path):
     # 500 times the ci loading rate, stopped at U = 100 d (~2 s): rods break, interfaces soften, the crack stays.
     # At G = 10 with the intact tip (the default until 2026-12-06): with the cut tip the crack grows 0.53 d and the
     # run blows up (kinetic / strain 9.07, measured 2026-12-06), which is not the case tested here.
     out = tmp_path / "fast"
-    r = run("run", PAPER_CASES / f"{THETA30}.toml", "--preset", "ci", "--out", out, "--quiet",
-            "--set", "rate_factor=500", "--set", "stop_u_over_d=100", "--set", "threads=1",
-            "--set", "Gamma_k_over_sigma0sq=10", "--set", 'crisscross_at_tip="intact"')
-    assert r.returncode == 0, r.stderr
+    r = fast_run(run, out, 100)
     with h5py.File(out / "result.h5", "r") as f:
         meta, h = f["meta"].attrs, f["history"]
         assert meta["status"] == "completed"
@@ -48,10 +54,7 @@ def test_the_stop_row_counts_in_the_quasi_static_maximum(run, tmp_path):
     # ratio beyond the loading's motion is larger than at any row before it (1.5533 against 1.5526, measured
     # 2026-12-07); the run's maximum must include that row, as the loop's rows are included.
     out = tmp_path / "stop"
-    r = run("run", PAPER_CASES / f"{THETA30}.toml", "--preset", "ci", "--out", out, "--quiet",
-            "--set", "rate_factor=500", "--set", "stop_u_over_d=23.8", "--set", "threads=1",
-            "--set", "Gamma_k_over_sigma0sq=10", "--set", 'crisscross_at_tip="intact"')
-    assert r.returncode == 0, r.stderr
+    fast_run(run, out, 23.8)
     with h5py.File(out / "result.h5", "r") as f:
         meta, h = f["meta"].attrs, f["history"]
         elastic_start = (h["inelastic_interfaces"][:] > 0) | (h["broken_rod_elements"][:] > 0)
