@@ -473,8 +473,8 @@ class RunLoop {
     if (opt_.checkpointIntervalSeconds > 0 && wall() - lastCheckpoint_ > opt_.checkpointIntervalSeconds) checkpoint();
   }
 
-  /// The last history row (its kinetic ratios noted as the loop's rows are) and frame, the result file under the name of its status (the partial one removed),
-  /// and the checkpoint removed when the run completed.
+  /// The last history row (its kinetic ratios noted as the loop's rows are) and frame, the result file under the
+  /// name of its status (the partial one removed), and the checkpoint removed when the run completed.
   RunRecord finish() {
     if (opt_.progress && tty_) std::fprintf(stderr, "\n");
     if (rec_.status != RunStatus::failed || rec_.history.empty() || rec_.history.back().step != sim_.state.step) {

@@ -1,4 +1,5 @@
 #include "setup.hpp"
+
 #include <dlfcn.h>
 
 #include <algorithm>
