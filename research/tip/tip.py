@@ -334,10 +334,9 @@ def main(argv=None) -> int:
     ph.add_argument("--stage", type=int, choices=(7, 8), default=7, help="7: phases k/4 (default); 8: phases k/8")
     a = ap.parse_args(argv)
     if a.cmd in ("report", "candidates", "twins", "phases"):
-        if a.cmd == "phases":
-            print(phases_report(PHASES if a.stage == 7 else STAGE8_PHASES), end="")
-            return 0
-        print(dict(report=report, candidates=candidates_report, twins=twins_report)[a.cmd](), end="")
+        def phases():
+            return phases_report(PHASES if a.stage == 7 else STAGE8_PHASES)
+        print(dict(report=report, candidates=candidates_report, twins=twins_report, phases=phases)[a.cmd](), end="")
         return 0
     out = RUNS / a.name
     if a.cmd == "record":

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <string>
+
 #include "case_params.hpp"
 #include "setup.hpp"
 
