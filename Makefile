@@ -28,9 +28,10 @@
 #   make reference      regenerate tests/reference/ (ci-preset R-curves the tests compare with)
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
-#   make bench          speed against error of every integrator and knob, and cost growth, in one run (~100 min on
-#                       2 cores at G = 3, ~2.5 h at G = 10; at the solver's default G, which the report's header names, or
-#                       BENCH_G=3): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
+#   make bench          [BENCH_G=3] [BENCH_FRESH=1]  speed against error of every integrator and knob, and cost growth
+#                       (~100 min on 2 cores at G = 3, ~2.5 h at G = 9; at the solver's default G, which the report's
+#                       header names); resumable: Ctrl-C stops the runs at a checkpoint, the same command continues
+#                       (BENCH_FRESH=1: all again): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
 #                       cases at the `converged` preset to Delta_a = 30 d, each by c09beab's build (built once in
 #                       build/baseline-c09beab/: the cost's baseline), by build/enamel-dem with CONVERGED_SET (new)
@@ -139,7 +140,7 @@ clean:
 
 bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS) \
-	  $(if $(BENCH_G),--G $(BENCH_G))
+	  $(if $(BENCH_G),--G $(BENCH_G)) $(if $(BENCH_FRESH),--fresh)
 
 # A converged run's cost: c09beab's build against this one (or CONVERGED_SET on it), the same R-curve decided by
 # enamel_results.metrics.same_rcurve. CONVERGED_ARGS passes more options (bench/converged_cost.py --help).

@@ -28,8 +28,9 @@ it reached and by which factor.
 
 Resumable: each run goes to RUNS/<preset>/<role>_<solver commit>[_<sets>]/<case>/ with the solver's checkpoints
 (--checkpoint-every) and its --resume; Ctrl-C or SIGTERM stops every run at a checkpoint, and the same command
-continues. A run whose result.h5 is complete and whose record (cost.json: its command and the CPU time of
-each piece) matches the command is not run again; --fresh deletes the runs first.
+continues. A run whose result.h5 is complete and whose record (bench/jobs.py: its command, the binary's SHA-256
+and the CPU time of each piece) matches the command and the binary is not run again; --fresh deletes the runs
+first.
 
 Writes bench/converged_cost.md and bench/converged_cost.csv at the `converged` preset; at another preset (a
 quick check: --preset ci) they go to the runs folder instead, so a check never stands for the table.
@@ -38,13 +39,11 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import json
 import math
 import os
 import pathlib
 import re
 import shutil
-import signal
 import subprocess
 import sys
 
@@ -52,6 +51,7 @@ import h5py
 import numpy as np
 
 import bench
+from bench import jobs as bench_jobs
 from bench import run_bench
 from enamel_results import metrics, paths, results
 from pipeline.phases import set_tag
@@ -63,7 +63,6 @@ RATIO_GOAL = 3.0
 TOLERANCE = metrics.TOL_RATE_SPEED
 RUNS = bench.RUNS / "converged_cost"
 TABLE = "converged_cost"             # OUT/converged_cost.md and .csv
-RECORD = "cost.json"                 # in each run's folder: its command and pieces
 CHECKPOINT_EVERY_S = 300.0
 # One thread a run, the static start's factorisation included: CHOLMOD's BLAS (OpenBLAS's pthread build) would
 # otherwise start a thread per core. Set for every solver the harness starts, baseline and new alike.
@@ -129,91 +128,30 @@ def solver_args(v: Variant, case: str, preset: str, out: pathlib.Path, checkpoin
     return args
 
 
-# ------------------------------------------------------------------------------------------------- records
-def read_record(out: pathlib.Path) -> dict:
-    try:
-        return json.loads((out / RECORD).read_text())
-    except (OSError, ValueError):
-        return {}
-
-
-def completed(out: pathlib.Path) -> bool:
-    try:
-        return results.load_result(out / paths.RESULT_NAMES["completed"]).completed
-    except (results.MissingResult, OSError):
-        return False
-
-
-def prepare(out: pathlib.Path, command: list[str]) -> bool:
-    """Whether the run in `out` must (still) run. A complete result with a record of this command is done; a
-    record of another command (or none beside a result) is started over: record and result removed."""
-    rec = read_record(out)
-    if rec.get("command") == command and completed(out) and rec.get("pieces"):
-        return False
-    if rec.get("command") != command:
-        for name in (RECORD, *paths.RESULT_NAMES.values(), "checkpoint.bin"):
-            (out / name).unlink(missing_ok=True)
-    return True
-
-
-def add_piece(job: run_bench.Job, command: list[str]) -> None:
-    """Append one piece (one solver process) to the run's record: when, how long, its CPU time, exit, machine."""
-    rec = read_record(job.out)
-    if rec.get("command") != command:
-        rec = {"command": command, "pieces": []}
-    start = datetime.datetime.now(datetime.timezone.utc) - datetime.timedelta(seconds=job.wall_s)
-    rec["pieces"].append(dict(started_utc=start.strftime("%Y-%m-%d %H:%M"), cpu_s=job.cpu_s, wall_s=job.wall_s,
-                              exit=job.returncode, machine=run_bench.machine()))
-    (job.out / RECORD).write_text(json.dumps(rec, indent=1) + "\n")
-
-
 # ---------------------------------------------------------------------------------------------------- runs
 def run_all(variants: list[Variant], cases, preset: str, runs: pathlib.Path, jobs: int, nice: int,
             checkpoint_every: float) -> None:
     """Every case by every variant, `jobs` at once, the baseline's first; Ctrl-C / SIGTERM: every running solver
-    writes its checkpoint and stops, its piece is recorded, and nothing more starts."""
-    todo, commands = [], {}
+    writes its checkpoint and stops, its piece is recorded, and nothing more starts (bench.jobs.run_resumable)."""
+    todo = []
     for v in (v for v in variants if v.same_as is None):
         for case in cases:
             out = runs / preset / v.label / case
             cmd = solver_args(v, case, preset, out, checkpoint_every)
-            out.mkdir(parents=True, exist_ok=True)
-            if not prepare(out, cmd):
-                print(f"{v.label} / {case}: complete, not run again ({out})")
-                continue
             wrapped = (["nice", "-n", str(nice)] if nice else []) + cmd   # nice execs: wait4 sees the solver
-            commands[str(out)] = cmd
-            todo.append(run_bench.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
-                                      expected_s=2.0 if v.role != "new" else 1.0))
-    stopping = []
-
-    def forward(signum, frame):
-        stopping.append(signum)
-        for j in todo:
-            if j.pid:
-                os.kill(j.pid, signum)
-    previous = {s: signal.signal(s, forward) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        run_bench.run_jobs(todo, jobs, on_done=lambda j: add_piece(j, commands[str(j.out)]),
-                           stop=lambda: bool(stopping), log_mode="a")
-    finally:
-        for s, h in previous.items():
-            signal.signal(s, h)
-    if stopping:
-        raise KeyboardInterrupt("stopped at a checkpoint: the same command continues")
+            todo.append((bench_jobs.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
+                                        expected_s=2.0 if v.role != "new" else 1.0), cmd))
+    bench_jobs.run_resumable(todo, jobs)
 
 
 # ---------------------------------------------------------------------------------------------------- rows
 def run_row(out: pathlib.Path) -> dict:
     """One run's numbers: core-seconds and wall seconds summed over its pieces, steps, DOF, commit, machines."""
-    rec = read_record(out)
-    pieces = rec.get("pieces", [])
+    t = bench_jobs.totals(out)
     r = results.load_result(out / paths.RESULT_NAMES["completed"])
-    return dict(core_s=sum(p["cpu_s"] for p in pieces), wall_s=sum(p["wall_s"] for p in pieces),
-                pieces=len(pieces), steps=int(r.meta["steps"]), dof=int(r.meta["dof"]), threads=int(r.meta["threads"]),
-                git=str(r.meta["git_hash"]), G=r.param(run_bench.G_KEY),
-                machines=sorted({p["machine"] for p in pieces}),
-                started_utc=pieces[0]["started_utc"] if pieces else "", result=r)
+    return dict(core_s=t["cpu_s"], wall_s=t["wall_s"], pieces=t["pieces"], steps=int(r.meta["steps"]),
+                dof=int(r.meta["dof"]), threads=int(r.meta["threads"]), git=str(r.meta["git_hash"]),
+                G=r.param(run_bench.G_KEY), machines=t["machines"], started_utc=t["started_utc"], result=r)
 
 
 def verdict(ratio: float, same: bool | None, goal: float = RATIO_GOAL, why: str = "") -> tuple[bool, str]:
@@ -251,16 +189,12 @@ def unit_rate_share(result_file: pathlib.Path) -> float | None:
     return float(np.diff(step)[at_one].sum() / (step[-1] - step[0]))
 
 
-def done(out: pathlib.Path) -> bool:
-    return completed(out) and bool(read_record(out).get("pieces"))
-
-
 def case_row(case: str, base: pathlib.Path, ref: pathlib.Path, new: pathlib.Path, goal: float = RATIO_GOAL) -> dict:
     """One case's row: the three runs' numbers (the reference's folder may be the new one's), the ratio of cost
     (baseline / new) and its factors, the levers' own ratio (reference / new), the new R-curve against the
     reference's (deciding) and against the baseline's (reported), and the verdict."""
     row = dict(case=case)
-    if not (done(base) and done(ref) and done(new)):
+    if not all(bench_jobs.done(d) for d in (base, ref, new)):
         row.update(status="incomplete", verdict=verdict(math.nan, None, goal)[1], met=False)
         return row
     b, r, n = run_row(base), run_row(ref), run_row(new)
@@ -362,7 +296,7 @@ def write_table(rows: list[dict], header: dict, out: pathlib.Path) -> list[pathl
 def header_of(rows: list[dict], a, base: Variant, ref: Variant, new: Variant) -> dict:
     gs = sorted({r[f"{role}_G"] for r in rows for role in ROLES if f"{role}_G" in r})
     return dict(date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
-                machine=run_bench.machine(), preset=a.preset, G=", ".join(f"{g:g}" for g in gs) or "n/a",
+                machine=bench_jobs.machine(), preset=a.preset, G=", ".join(f"{g:g}" for g in gs) or "n/a",
                 jobs=a.jobs, nice=f", nice {a.nice}" if a.nice else "", goal=a.goal,
                 baseline=a.baseline if not a.baseline_binary else f"{a.baseline_binary}",
                 new=f"{new.binary}" + (f" with {' '.join(a.set)}" if a.set else ""),

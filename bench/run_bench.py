@@ -22,15 +22,18 @@ machine in the same state:
 
 Writes bench/results.csv, bench/cost_growth.csv, bench/profile.md, bench/results.md (the README quotes them) and
 bench/out/pareto.{pdf,png}, bench/out/cost_growth.{pdf,png}. Runs go to runs/bench/.
+
+Resumable (bench/jobs.py): Ctrl-C or SIGTERM stops every running solver at a checkpoint (each also writes one
+every 300 s), and the same command continues; a run already done by the same command and solver binary is kept,
+its time read from its record (summed over its pieces), and the report says when its runs started and how many
+ran in more than one piece. The step profile is measured again at each sitting. --fresh runs everything again.
 """
 import argparse
 import csv
-import dataclasses
 import datetime
 import math
 import os
 import pathlib
-import platform
 import shutil
 import subprocess
 import sys
@@ -45,7 +48,7 @@ import matplotlib.ticker  # noqa: E402
 
 import bench  # noqa: E402
 from enamel_results import metrics, paths, results  # noqa: E402
-from bench import records  # noqa: E402
+from bench.jobs import Job, machine, run_resumable, totals  # noqa: E402
 from bench.records import history_end  # noqa: E402
 from enamel_results.constants import KINETIC_WARN  # noqa: E402  the solver's quasi-static warning bound
 from figures import plotting  # noqa: E402
@@ -150,24 +153,6 @@ def profile_markdown(preset: str, threads_list=(1, 2), extra_sets: dict | None =
     return "\n".join(out)
 
 
-@dataclasses.dataclass
-class Job:
-    case: str                # the case, or "cost" for the cost-growth runs
-    variant: str             # the variant's name, or (cost) the integrator
-    args: list
-    cores: int
-    out: pathlib.Path
-    expected_s: float = 0.0  # for ordering: longest first
-    wall_s: float = math.nan
-    cpu_s: float = math.nan
-    returncode: int = -1
-    pid: int = 0             # while it runs
-
-    @property
-    def key(self) -> str:
-        return f"{self.case} / {self.variant} ({self.out.name})"
-
-
 def solver() -> pathlib.Path:
     return pathlib.Path(os.environ.get("ENAMEL_BINARY", paths.SOLVER))
 
@@ -177,53 +162,36 @@ def variant_dir(runs: pathlib.Path, case: str, variant: str) -> pathlib.Path:
     return runs / case / variant.replace(" ", "_")
 
 
-def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path, flags=("--force", "--quiet")) -> list:
+# A bench run continues from its checkpoint when it was stopped (bench/jobs.py: its record decides whether it runs).
+RUN_FLAGS = ("--resume", "--quiet", "--checkpoint-every", "300")
+
+
+def run_args(case_file, preset, sets: dict, threads: int, out: pathlib.Path, flags=RUN_FLAGS) -> list:
     a = [str(solver()), "run", str(case_file), "--preset", preset, "--out", str(out), *flags]
     for k, v in {**sets, "threads": threads}.items():
         a += ["--set", f"{k}={v}"]
     return a
 
 
-def run_jobs(jobs: list[Job], cores: int, log=print, on_done=None, stop=None, log_mode="w") -> None:
-    """Run the jobs, longest first, never using more than `cores` cores; records wall, CPU and peak memory of
-    each (os.wait4 gives the child's own CPU time; its maxrss would count the forking Python's pages, so peak
-    memory comes from the solver's /meta/peak_memory_mb). on_done(job) is called as each ends; once stop()
-    is true no further job starts (those running are waited for). Each job's output goes to OUT/bench.log,
-    opened with log_mode ("a": a resumed run keeps the log of its earlier pieces)."""
-    pending = sorted(jobs, key=lambda j: -j.expected_s)
-    running = {}   # pid -> (job, start, popen)
-    free = cores
-    t_all = time.perf_counter()
-    while running or (pending and not (stop and stop())):
-        started = True
-        while started and not (stop and stop()):
-            started = False
-            for j in pending:
-                if j.cores <= free or (not running and j.cores > cores):
-                    j.out.mkdir(parents=True, exist_ok=True)
-                    with open(j.out / "bench.log", log_mode) as logf:
-                        p = subprocess.Popen(j.args, stdout=logf, stderr=subprocess.STDOUT)
-                    j.pid = p.pid
-                    running[p.pid] = (j, time.perf_counter(), p)
-                    free -= j.cores
-                    pending.remove(j)
-                    started = True
-                    break
-        if not running:
-            break
-        pid, status, ru = os.wait4(-1, 0)
-        if pid not in running:
-            continue
-        j, t0, p = running.pop(pid)
-        p.returncode = os.waitstatus_to_exitcode(status)
-        j.returncode, j.pid = p.returncode, 0
-        j.wall_s = time.perf_counter() - t0
-        j.cpu_s = ru.ru_utime + ru.ru_stime
-        free += j.cores
-        log(f"[{time.perf_counter() - t_all:7.0f} s] {j.key}: exit {j.returncode}, {j.wall_s:.1f} s wall, "
-            f"{j.cpu_s:.1f} s CPU")
-        if on_done:
-            on_done(j)
+def run_pieces(jobs: list[Job], cores: int) -> None:
+    """Run the jobs that are not done yet (bench.jobs.run_resumable), then give every job its cost over all its
+    pieces, earlier sittings included: wall and CPU seconds summed, the last piece's exit status."""
+    run_resumable([(j, j.args) for j in jobs], cores)
+    for j in jobs:
+        t = totals(j.out)
+        j.wall_s, j.cpu_s, j.returncode = t["wall_s"], t["cpu_s"], t["exit"]
+
+
+def sittings_note(jobs: list[Job]) -> str:
+    """How the bench's runs were made: in this sitting, or (resumed) with pieces from earlier ones."""
+    t = [totals(j.out) for j in jobs]
+    starts = sorted(x["started_utc"] for x in t if x["started_utc"])
+    several = sum(x["pieces"] > 1 for x in t)
+    if not starts:
+        return ""
+    return (f"Its {len(jobs)} runs started from {starts[0]} to {starts[-1]} UTC; {several} of them in more than one "
+            "piece (stopped at a checkpoint and continued: wall and CPU time summed over the pieces, the set-up "
+            "counted in each).")
 
 
 def speed_comparison(ref, r) -> metrics.Comparison | None:
@@ -428,12 +396,6 @@ def cost_figure(rows, out_dir: pathlib.Path, title: str) -> list[pathlib.Path]:
     return plotting.save_to(fig, out_dir, "cost_growth")
 
 
-def machine() -> str:
-    cpu = records.cpu_model()
-    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30
-    return f"{cpu}, {os.cpu_count()} cores, {mem:.0f} GiB, {platform.system()} {platform.release()}"
-
-
 def fmt(v, spec=".3g"):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
@@ -442,7 +404,7 @@ def summary_markdown(rows, crows, header: dict) -> str:
     L = [f"# Bench results ({header['date']}, G = {header['G']:g})", "",
          f"Machine: {header['machine']}. Solver {header['git']}. Preset `{header['preset']}`, "
          f"G = {G_KEY} = {header['G']:g} ({header['G_source']}); "
-         f"{header['jobs']} runs at a time; whole bench {header['total_min']:.0f} min. "
+         f"{header['jobs']} runs at a time; this sitting {header['total_min']:.0f} min. {header.get('sittings', '')} "
          f"Reference: `{REFERENCE}` at the preset's rate (the slowest measured). "
          f"Bound: the same R-curve as the reference (`enamel_results.metrics.same_rcurve`: R averaged over crack "
          f"advance over (0,30] d or the common range of at least {metrics.MIN_RANGE_OVER_D:g} d, and R_init, within "
@@ -535,6 +497,9 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--cases", nargs="+", choices=CASES, help="only these cases (default: all)")
     ap.add_argument("--variants", nargs="+", choices=list(VARIANTS),
                     help=f"only these variants (default: all; `{REFERENCE}` is always run: it is the reference)")
+    ap.add_argument("--fresh", action="store_true",
+                    help="delete this bench's runs first and run them all again (default: runs done by the same "
+                         "command and solver binary are kept, stopped ones continue)")
     ap.add_argument("--profile-only", action="store_true",
                     help="only the step profile (bench/profile.md): a few minutes")
     ap.add_argument("--replot", action="store_true",
@@ -575,16 +540,25 @@ def main(argv=None) -> int:
     print(a.out / "profile.md")
     if a.profile_only:
         return 0
-    for sub in (*CASES, "cost"):   # this bench's runs only: runs/bench/ also holds bench-paper's and bench-converged's
-        shutil.rmtree(a.runs / sub, ignore_errors=True)
+    if a.fresh:
+        for sub in (*CASES, "cost"):   # this bench's runs only: runs/bench/ also holds bench-paper's and bench-converged's
+            shutil.rmtree(a.runs / sub, ignore_errors=True)
+    try:
+        return measure(a, cases, variants, sizes, extra, t0, date, g_source, profile_md)
+    except KeyboardInterrupt as e:
+        print(f"run_bench.py: {e or 'stopped'}", file=sys.stderr)
+        return 130
 
+
+def measure(a, cases, variants, sizes, extra, t0, date, g_source, profile_md) -> int:
+    """The runs (those not done yet), then the tables, the figures and the report."""
     jobs = speed_error_jobs(cases, variants, PRESET, a.runs, extra)
-    run_jobs(jobs, a.jobs)
+    run_pieces(jobs, a.jobs)
     rows = speed_error_rows(jobs)
     a.out.mkdir(parents=True, exist_ok=True)
     write_csv(rows, a.out / "results.csv")
 
-    crows, cost_note = [], ""
+    crows, cjobs, cost_note = [], [], ""
     if not a.skip_cost:
         ref = next((r for r in rows if r["variant"] == REFERENCE and r.get("status") == "completed"), None)
         run_model = {}
@@ -593,7 +567,7 @@ def main(argv=None) -> int:
             run_model = dict(U_end=ref["U_end"], h_s=rr.param("h_s_over_d"),
                              v_app_over_cd=rr.param("v_app_over_cd") * rr.param("rate_factor"))
         cjobs = cost_jobs(a.runs, sizes, ("lumped", "paper"), {"stop_da_over_d": 1e3} if not a.quick else {})
-        run_jobs(cjobs, 1)   # one at a time: time per step without a neighbour on the other core
+        run_pieces(cjobs, 1)   # one at a time: time per step without a neighbour on the other core
         crows = cost_rows(cjobs, run_model)
         write_csv(crows, a.out / "cost_growth.csv")
         cost_note = ("Estimated steps per run = T_run/dt, T_run = ramp + U_end/v_app, U_end = U_end of the "
@@ -604,7 +578,8 @@ def main(argv=None) -> int:
     solver_hash = results.load_result(ref_h5).meta["git_hash"] if ref_h5 and ref_h5.exists() else "unknown"
     header = dict(date=date, machine=machine(), git=solver_hash, preset=PRESET, jobs=a.jobs,
                   G=BENCH_PHYSICS[G_KEY], G_source=g_source,
-                  total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note)
+                  total_min=(time.perf_counter() - t0) / 60, cost_note=cost_note,
+                  sittings=sittings_note(jobs + cjobs))
     title = (f"enamel-dem bench, preset {PRESET}, G = {header['G']:g}, {header['date']}, "
              f"{header['machine'].split(',')[0]}")
     pareto_figure(rows, a.out / "out", title)

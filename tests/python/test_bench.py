@@ -19,11 +19,29 @@ from enamel_results.constants import EXIT
 
 
 def test_quick_bench_writes_its_report(enamel, tmp_path):
+    """Stopped by Ctrl-C while its reference runs, then continued by the same command: the report, with each run's
+    time summed over its pieces; a third time it runs nothing again."""
+    from bench import jobs
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
-    r = subprocess.run([sys.executable, "-m", "bench.run_bench", "--quick", "--out",
-                        str(tmp_path), "--runs", str(tmp_path / "runs")], capture_output=True, text=True, env=env,
-                       timeout=600, cwd=ROOT)
+    command = [sys.executable, "-m", "bench.run_bench", "--quick", "--out", str(tmp_path), "--runs",
+               str(tmp_path / "runs")]
+    reference = tmp_path / "runs" / "theta30_s21.4_e10_cv0" / "paper"
+    first = subprocess.Popen(command, env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    t0 = time.monotonic()
+    while not (reference / "result.partial.h5").exists() and time.monotonic() - t0 < 120:
+        time.sleep(0.2)   # once it exists the solver handles SIGINT (a checkpoint, then exit)
+    time.sleep(1.0)
+    first.send_signal(signal.SIGINT)
+    out, err = first.communicate(timeout=120)
+    assert first.returncode == 130 and "the same command continues" in err, (out, err)
+    assert (reference / "checkpoint.bin").exists() and not (reference / "result.h5").exists()
+    assert [p["exit"] for p in jobs.read_record(reference)["pieces"]] == [EXIT["interrupted"]]
+    assert not (tmp_path / "results.csv").exists()
+
+    r = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=ROOT)
     assert r.returncode == 0, r.stderr
+    pieces = jobs.read_record(reference)["pieces"]
+    assert [p["exit"] for p in pieces] == [EXIT["interrupted"], 0]
     rows = list(csv.DictReader(open(tmp_path / "results.csv")))
     assert [row["variant"] for row in rows] == ["paper", "lumped", "lumped rate2"]
     ref = rows[0]
@@ -53,6 +71,23 @@ def test_quick_bench_writes_its_report(enamel, tmp_path):
     assert md.splitlines()[0].endswith(f", G = {G:g})")
     ref_run = results.load_result(tmp_path / "runs" / ref["case"] / "paper" / "result.h5")
     assert ref_run.param(G_KEY) == G
+    # the reference's time is its two pieces' (the set-up counted in each), and the report says so
+    assert math.isclose(float(ref["wall_s"]), sum(p["wall_s"] for p in pieces), rel_tol=1e-5)
+    assert math.isclose(float(ref["cpu_s"]), sum(p["cpu_s"] for p in pieces), rel_tol=1e-5)
+    resumed = [d for d in (tmp_path / "runs").glob("*/*") if len(jobs.read_record(d)["pieces"]) > 1]
+    assert reference in resumed and f"; {len(resumed)} of them in more than one piece" in md
+
+    again = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=ROOT)
+    assert again.returncode == 0, again.stderr
+    assert again.stdout.count("complete, not run again") == len(rows) + len(cost)
+    assert list(csv.DictReader(open(tmp_path / "results.csv"))) == rows   # the same times, from the records
+    assert len(jobs.read_record(reference)["pieces"]) == 2
+    # another binary at the same path (a rebuilt solver) or another command starts the run over
+    rec = jobs.read_record(reference)
+    assert not jobs.prepare(reference, rec["command"], rec["solver_sha256"])
+    assert rec["solver_sha256"] == jobs.binary_digest(enamel)
+    assert jobs.prepare(reference, rec["command"], "0" * 64)
+    assert not (reference / "result.h5").exists() and not (reference / jobs.RECORD).exists()
 
 
 def test_within_the_bound_needs_no_quasi_static_warning():
