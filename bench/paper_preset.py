@@ -14,7 +14,14 @@ result is the same, bit for bit at the same thread count). A checkpoint is also 
 Then it writes bench/paper_preset.md (committed: the README quotes it) and bench/out/paper_preset.{pdf,png}:
 the R-curve against the same case at the `reduced` size (the `paper` scheme and the same fast scheme, from
 `make bench`, when their runs are there) and the paper's value, and the process zone at the last frame.
-An unfinished run is reported as such (how far it got, how long it took so far).
+An unfinished run is reported as such (how far it got, how long it took so far). The report also says:
+- the run against the goal of Delta_a = 30 d in at most 15 min of stepping on 2 cores (GOAL_STEPPING_S): met or
+  not, and how many of its steps fit in 15 min at its own mean rate of steps;
+- whether its R-curve is the same as that of the committed record of this case at this size (--against, default
+  AGAINST: the run of 2026-12-06, solver 16b804e, AMD EPYC 2-core, at the default model), by
+  `enamel_results.metrics.same_rcurve` at the speed tolerance: what a faster variant (--set) must keep.
+A variant's --set overrides name its run's folder (RUNS/CASE__<sets>); a folder that holds a run of another
+command (its log's first line) is refused with a message naming both, and nothing in it is touched.
 """
 import argparse
 import datetime
@@ -32,8 +39,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import bench  # noqa: E402
 from bench import run_bench  # noqa: E402
 from bench import records  # noqa: E402
-from enamel_results import paper_values, paths, results  # noqa: E402
+from enamel_results import metrics, paper_values, paths, records as run_records, results  # noqa: E402
 from figures import plotting  # noqa: E402
+from pipeline.phases import set_tag  # noqa: E402
 
 CASE = run_bench.CASES[0]
 # The preset's loading rate, from the static start. Twice the rate was the fastest loading within the bound at
@@ -42,13 +50,20 @@ CASE = run_bench.CASES[0]
 # runs of 2026-12-04 on an AMD EPYC, solver 6008856 and later). It takes about twice the steps (345 k).
 VARIANT = "lumped cap0.5 dt0.22 static"
 PRESET = "paper"
-EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests)
+EXTRA_SETS = {}                    # --quick: a tiny specimen at the ci preset (tests); and --set
+USER_SETS = []                     # --set KEY=VALUE as given: they name the run's folder
 RUNS = bench.PAPER_PRESET_RUNS    # --runs
 OUT = bench.HERE                  # --out: paper_preset.md and out/paper_preset.{pdf,png}
+GOAL_DA, GOAL_STEPPING_S = 30.0, 15 * 60.0   # Delta_a = 30 d in at most this much stepping, on 2 cores
+# The committed record of this case at this size (python3 -m pipeline.records write of the run of 2026-12-06,
+# solver 16b804e, the default model: G = 9, cut tip; AMD EPYC 2-core, 1.23 h): what a faster variant is judged by.
+AGAINST = bench.HERE / "paper_preset_record.json"
 
 
 def run_dir() -> pathlib.Path:
-    return RUNS / CASE
+    """RUNS/CASE, or RUNS/CASE__<the --set overrides> (as the pipeline names a RUN_SET folder): a variant's own."""
+    tag = set_tag(USER_SETS)
+    return RUNS / (CASE + (f"__{tag}" if tag else ""))
 
 
 def solver_command(threads: int, checkpoint_every: float) -> list:
@@ -69,6 +84,12 @@ def run(threads: int, checkpoint_every: float) -> int:
     out = run_dir()
     out.mkdir(parents=True, exist_ok=True)
     result = out / "result.h5"
+    cmd = solver_command(threads, checkpoint_every)
+    first = first_command(out)
+    if first is not None and first != " ".join(cmd) and (result.exists() or (out / "checkpoint.bin").exists()):
+        print(f"paper_preset.py: {out} holds a run of another command ({first}); this one is {' '.join(cmd)}: "
+              "pass --runs DIR for a folder of its own, or delete that one", file=sys.stderr)
+        return 2
     if result.exists():
         try:
             status = results.load_result(result, case=CASE).status
@@ -78,7 +99,6 @@ def run(threads: int, checkpoint_every: float) -> int:
             print(f"paper_preset.py: {result} is complete; reporting it (delete it to run again)")
             return 0
     restart = (out / "checkpoint.bin").exists()
-    cmd = solver_command(threads, checkpoint_every)
     # Ctrl-C or SIGTERM: passed on to the solver (which writes its checkpoint and stops), never raised here, so
     # every line it writes up to its exit reaches the log.
     children = []
@@ -138,6 +158,35 @@ def cost_estimate_steps(r: results.Result) -> float:
     return row["est_steps_per_run_at_1e-3"] * row["dt"] / r.meta["dt"] if row else math.nan
 
 
+def goal_line(r: results.Result, steps: int, wall: float, threads: int) -> str:
+    """The run against the goal: Delta_a = 30 d in at most GOAL_STEPPING_S of stepping on 2 cores."""
+    met = r.completed and r.da_max >= GOAL_DA and wall <= GOAL_STEPPING_S and threads <= 2
+    fit = steps / wall * GOAL_STEPPING_S
+    return (f"- against the goal (Delta_a = {GOAL_DA:g} d in at most {GOAL_STEPPING_S / 60:g} min of stepping on 2 cores): "
+            f"**{'met' if met else 'not met'}**, {wall / 60:.0f} min ({wall / GOAL_STEPPING_S:.2f}x the goal); at its "
+            f"mean {steps / wall:.1f} steps/s, {GOAL_STEPPING_S / 60:g} min hold {fit:,.0f} of its {steps:,} steps")
+
+
+def against_line(r: results.Result, record: pathlib.Path) -> str:
+    """This run's R-curve against a committed record of the case (the reference) by metrics.same_rcurve at the
+    speed tolerance, or why it cannot be compared."""
+    try:
+        ref = run_records.load(record, case=CASE)
+    except (results.MissingResult, run_records.MalformedRecord) as e:
+        return f"- against the record {record}: none to compare with ({e})"
+    if ref.da.size < 2 or r.da.size < 2:
+        return f"- against the record {record}: no R-curve to compare"
+    c = metrics.same_rcurve(metrics.rcurve_of(ref), metrics.rcurve_of(r), metrics.TOL_RATE_SPEED)
+    head = (f"- against the committed record `{record.name}` (solver {ref.meta.get('git_hash', '?')}, the reference; "
+            f"`enamel_results.metrics.same_rcurve` at {metrics.TOL_RATE_SPEED:.0%}): ")
+    if not c.comparable:
+        return head + (f"not comparable (the common range (0, {c.hi:.1f}] d is shorter than "
+                       f"{metrics.MIN_RANGE_OVER_D:g} d)")
+    return head + (f"the same R-curve: **{c.same}** (R mean over (0, {c.hi:.1f}] d {c.mean_a:.4g} / {c.mean_b:.4g}, "
+                   f"{c.mean_rel:+.2%}; R_init {c.init_rel:+.2%}; broken rods {c.rods_a} / {c.rods_b}; pointwise L2 "
+                   f"{c.l2:.2%}, not deciding)")
+
+
 def figure(r: results.Result, reduced: dict, title: str) -> list[pathlib.Path]:
     fig, (ax, *maps) = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw=dict(width_ratios=[1.3, 1, 1, 1]),
                                    layout="constrained")
@@ -169,7 +218,7 @@ def figure(r: results.Result, reduced: dict, title: str) -> list[pathlib.Path]:
     return plotting.save_to(fig, OUT / "out", "paper_preset")
 
 
-def report() -> int:
+def report(against: pathlib.Path = AGAINST) -> int:
     h5 = result_file(run_dir())
     try:
         r = results.load_result(h5, case=CASE, full=True)
@@ -202,7 +251,8 @@ def report() -> int:
          f"- peak memory {m['peak_memory_mb']:.0f} MB; broken rod elements {r.broken_rods}; "
          f"max KE/SE while the crack grows {m['max_kinetic_over_strain_while_growing']:.3g}; "
          f"energy balance error at the end {end['balance_end']:.2e}",
-         f"- warnings: {m['warnings'].strip() or 'none'}", ""]
+         f"- warnings: {m['warnings'].strip() or 'none'}",
+         goal_line(r, steps, wall, threads), against_line(r, against), ""]
     if row:
         L += [f"The variant on the reduced case (bench/results.md): {float(row['speedup_wall']):.1f}x faster than "
               f"`paper`, R-curve L2 {float(row['rcurve_rel_l2']):.2%}.", ""]
@@ -225,6 +275,15 @@ def report() -> int:
     return 0
 
 
+def first_command(out: pathlib.Path) -> str | None:
+    """The solver command of the run's first piece, from its log's first header line (None: no log)."""
+    try:
+        return next((line.split(" UTC: ", 1)[1].strip() for line in open(out / "log.txt")
+                     if line.startswith("# ") and " UTC: " in line), None)
+    except OSError:
+        return None
+
+
 def _segments() -> int:
     """How many times the run was started or continued (headers in its log)."""
     try:
@@ -234,7 +293,7 @@ def _segments() -> int:
 
 
 def main(argv=None) -> int:
-    global PRESET, EXTRA_SETS, RUNS, OUT
+    global PRESET, EXTRA_SETS, USER_SETS, RUNS, OUT
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--threads", type=int, default=2, help="solver threads (default 2; keep it for a restart)")
     ap.add_argument("--checkpoint-every", type=float, default=600.0,
@@ -245,6 +304,8 @@ def main(argv=None) -> int:
                     help=f"where paper_preset.md and out/paper_preset.png go (default {OUT})")
     ap.add_argument("--quick", action="store_true",
                     help="a small smoke run (tests): an 8 d x 4 d specimen at the ci preset, to Delta_a = 1 d")
+    ap.add_argument("--against", type=pathlib.Path, default=AGAINST,
+                    help=f"the committed record whose R-curve the run must keep (default {AGAINST})")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="one more solver override (tests, experiments; a restart needs the same ones)")
     a = ap.parse_args(argv)
@@ -256,6 +317,7 @@ def main(argv=None) -> int:
         if not eq:
             ap.error(f"--set {kv}: expected KEY=VALUE")
         EXTRA_SETS = {**EXTRA_SETS, key: value}
+    USER_SETS = list(a.set)
     sys.stdout.reconfigure(line_buffering=True)
     if not a.report:
         if not run_bench.solver().exists():
@@ -265,9 +327,9 @@ def main(argv=None) -> int:
         rc = run(a.threads, a.checkpoint_every)
         if not result_file(run_dir()).exists():
             return rc
-        reported = report()   # an interrupted or failed run is reported too, and its exit status kept
+        reported = report(a.against)   # an interrupted or failed run is reported too, and its exit status kept
         return rc or reported
-    return report()
+    return report(a.against)
 
 
 if __name__ == "__main__":

@@ -184,7 +184,7 @@ def start_paper_preset(enamel, tmp_path):
     env = dict(os.environ, ENAMEL_BINARY=str(enamel))
     cmd = [sys.executable, "-m", "bench.paper_preset", "--quick", "--threads", "1", "--runs", str(tmp_path / "runs"),
            "--out", str(tmp_path), "--set", "stop_da_over_d=1e3", "--set", "max_steps=120000"]
-    run = tmp_path / "runs" / "theta30_s21.4_e10_cv0"
+    run = tmp_path / "runs" / "theta30_s21.4_e10_cv0__stop_da_over_d-1e3_max_steps-120000"   # its --set's folder
     p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True, cwd=ROOT)
     deadline = time.time() + 120
@@ -215,12 +215,43 @@ def test_paper_preset_run_stops_on_ctrl_c_and_continues(enamel, tmp_path):
     assert "status: **completed**" in md
     assert "interrupted after" in (run / "log.txt").read_text()   # the first part's last lines were logged
     assert "2 pieces" in md
+    assert "against the goal (Delta_a = 30 d in at most 15 min of stepping on 2 cores): **not met**" in md
+    assert "`paper_preset_record.json`" in md and "not comparable" in md   # an 8 d specimen against 200 d's 30 d
     assert sum(line.startswith("# ") for line in open(run / "log.txt")) == 2
     for name in ("paper_preset.png", "paper_preset.pdf"):
         assert (tmp_path / "out" / name).stat().st_size > 1000
 
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert r.returncode == 0 and "is complete; reporting it" in r.stdout
+    # another command into the same folder (here another thread count) is refused, naming both; the run is kept
+    before = (run / "result.h5").read_bytes()
+    other = [("2" if prev == "--threads" else w) for prev, w in zip([None] + cmd, cmd)]
+    r = subprocess.run(other, env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert r.returncode == 2 and "holds a run of another command" in r.stderr and "threads=2" in r.stderr, r.stderr
+    assert (run / "result.h5").read_bytes() == before
+
+
+def test_paper_preset_judges_its_run_by_the_goal_and_the_committed_record():
+    """`make bench-paper`'s report: the goal (30 d in 15 min of stepping on 2 cores) met or not, and the run's
+    R-curve against the committed paper-size record by metrics.same_rcurve: the record against itself is the
+    same, R 5% higher is not, a missing record is said."""
+    import copy
+    import pathlib
+    from bench import paper_preset as pp
+    from enamel_results import records
+    r = records.load(pp.AGAINST, case=pp.CASE)
+    assert r.param("w_s_over_d") == 200 and r.completed
+    line = pp.against_line(r, pp.AGAINST)
+    assert "the same R-curve: **True**" in line and "+0.00%" in line and f"broken rods {r.broken_rods} / " in line
+    higher = copy.copy(r)
+    higher.R = r.R * 1.05
+    assert "the same R-curve: **False**" in pp.against_line(higher, pp.AGAINST) and "+5.00%" in pp.against_line(
+        higher, pp.AGAINST)
+    assert "none to compare with" in pp.against_line(r, pathlib.Path("/nonexistent/record.json"))
+    assert "**not met**, 74 min (4.91x the goal)" in pp.goal_line(r, 324298, 4422.0, 2)
+    assert "66,004 of its 324,298 steps" in pp.goal_line(r, 324298, 4422.0, 2)
+    assert "**met**, 14 min" in pp.goal_line(r, 100000, 840.0, 2)
+    assert "**not met**" in pp.goal_line(r, 100000, 840.0, 4)   # more than 2 cores
 
 
 def test_paper_preset_passes_sigterm_on_to_the_solver(enamel, tmp_path):
