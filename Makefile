@@ -29,7 +29,7 @@
 #   make clean-runs     [PRESET=...]  delete runs/<preset>/ and figures/out/<preset>/
 #
 #   make bench          [BENCH_G=3] [BENCH_FRESH=1]  speed against error of every integrator and knob, and cost growth
-#                       (~100 min on 2 cores at G = 3, ~2.5 h at G = 9; at the solver's default G, which the report's
+#                       (98 min on 2 cores at G = 3, 141 min at G = 9; at the solver's default G, which the report's
 #                       header names); resumable: Ctrl-C stops the runs at a checkpoint, the same command continues
 #                       (BENCH_FRESH=1: all again): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
 #   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
