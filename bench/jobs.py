@@ -127,11 +127,11 @@ def prepare(out: pathlib.Path, command: list[str], digest: str) -> bool:
     """Whether the run in `out` must (still) run. A complete result with a record of this command and binary is
     done; a record of another command or binary, or a complete result without its pieces (its cost unknown), is
     started over: record, results and checkpoint removed. Otherwise (a stopped run) it continues."""
-    rec = read_record(out)
+    rec, complete = read_record(out), completed(out)
     same = rec.get("command") == command and rec.get("solver_sha256") == digest
-    if same and done(out):
+    if same and complete and rec.get("pieces"):
         return False
-    if not same or completed(out):
+    if not same or complete:
         for name in (RECORD, *paths.RESULT_NAMES.values(), "checkpoint.bin"):
             (out / name).unlink(missing_ok=True)
     return True

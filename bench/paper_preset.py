@@ -85,7 +85,7 @@ def run(threads: int, checkpoint_every: float) -> int:
     out.mkdir(parents=True, exist_ok=True)
     result = out / "result.h5"
     cmd = solver_command(threads, checkpoint_every)
-    first = first_command(out)
+    first = next(iter(log_commands(out)), None)
     if first is not None and first != " ".join(cmd) and (result.exists() or (out / "checkpoint.bin").exists()):
         print(f"paper_preset.py: {out} holds a run of another command ({first}); this one is {' '.join(cmd)}: "
               "pass --runs DIR for a folder of its own, or delete that one", file=sys.stderr)
@@ -242,7 +242,7 @@ def report(against: pathlib.Path = AGAINST) -> int:
          ("" if r.completed else " — not finished: `make bench-paper` continues it"),
          f"- crack advance reached: {r.da_max:.2f} d of {r.param('stop_da_over_d'):g} d",
          f"- wall time of the stepping: **{wall / 3600:.2f} h** ({wall:.0f} s; summed over the run's "
-         f"{max(1, _segments())} pieces (starts and continuations), the work redone after a stop between "
+         f"{max(1, len(log_commands(run_dir())))} pieces (starts and continuations), the work redone after a stop between "
          "checkpoints left out; it counts whatever else shared the machine meanwhile)",
          f"- steps: {steps:,} (dt = {m['dt']:.4g} d/c_r); {steps / wall:.1f} steps/s; "
          f"{dof * steps / wall / threads / 1e6:.1f} M DOF-updates/s per core",
@@ -275,21 +275,14 @@ def report(against: pathlib.Path = AGAINST) -> int:
     return 0
 
 
-def first_command(out: pathlib.Path) -> str | None:
-    """The solver command of the run's first piece, from its log's first header line (None: no log)."""
+def log_commands(out: pathlib.Path) -> list[str]:
+    """The solver command of each piece of the run (each start or continuation), from its log's header lines
+    (`# DATE UTC: COMMAND`); [] without a log."""
     try:
-        return next((line.split(" UTC: ", 1)[1].strip() for line in open(out / "log.txt")
-                     if line.startswith("# ") and " UTC: " in line), None)
+        return [line.split(" UTC: ", 1)[1].strip() for line in open(out / "log.txt")
+                if line.startswith("# ") and " UTC: " in line]
     except OSError:
-        return None
-
-
-def _segments() -> int:
-    """How many times the run was started or continued (headers in its log)."""
-    try:
-        return sum(1 for line in open(run_dir() / "log.txt") if line.startswith("# "))
-    except OSError:
-        return 0
+        return []
 
 
 def main(argv=None) -> int:
