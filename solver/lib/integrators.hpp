@@ -51,6 +51,13 @@ class Integrator {
   /// A bound on how far any DOF moved in the last step, max_i |q_i(t_{n+1}) - q_i(t_n)| (round-off included);
   /// infinite when the scheme gives none (then the deletion check computes every rod element).
   virtual double lastStepMoveBound() const { return INFINITY; }
+  /// Per slice k, a bound on how far any DOF of its nodes moved in the last step (round-off included; each at
+  /// most lastStepMoveBound); empty when the scheme gives only the global bound. The schedules follow each slice's
+  /// own drift with it, so that where nothing moves nothing is computed.
+  virtual const std::vector<double>& lastStepMoveBoundsOfSlices() const {
+    static const std::vector<double> none;
+    return none;
+  }
   /// The schedule of the interface law the step keeps (`lumped`, kernels.hpp InterfaceSchedule; its `evaluated`:
   /// the last step's count); null when the scheme evaluates every interface at every step.
   virtual const InterfaceSchedule* interfaceSchedule() const { return nullptr; }

@@ -158,19 +158,20 @@ double lambdaTrack(const cohesive::Law& law) { return std::sqrt(cohesive::kElast
 }  // namespace
 
 void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Operators& ops, double moved,
-                              double largestValue, InterfaceSchedule& schedule) {
+                              const std::vector<double>& sliceMoved, double largestValue, InterfaceSchedule& schedule) {
   if (!std::isfinite(moved) || static_cast<int>(schedule.due.size()) != m.numInterfaces()) {
-    schedule.drift = 0;
+    schedule.drift.assign(m.numSlices, 0.0);
     schedule.due.assign(m.numInterfaces(), 0.0);
     schedule.sliceDue.assign(m.numSlices, 0.0);
     schedule.largestRate = 0;
     for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(law, g));
   } else {
-    schedule.drift += moved * (1.0 + 1e-6);  // the 1e-6 covers the round-off of this running sum
+    const bool perSlice = static_cast<int>(sliceMoved.size()) == m.numSlices;
+    for (int k = 0; k < m.numSlices; ++k)  // the 1e-6 covers the round-off of these running sums
+      schedule.drift[k] += (perSlice ? sliceMoved[k] : moved) * (1.0 + 1e-6);
   }
   const double roundOff = 32.0 * std::numeric_limits<double>::epsilon() * schedule.largestRate * largestValue;
-  const bool small = roundOff <= 0.25 * kInterfaceScheduleMargin * lambdaTrack(law);  // false for a NaN
-  schedule.dueBelow = small ? schedule.drift : INFINITY;
+  schedule.allDue = !(roundOff <= 0.25 * kInterfaceScheduleMargin * lambdaTrack(law));  // true for a NaN
 }
 
 NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law, const Operators& ops) {
@@ -208,7 +209,7 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
 [[gnu::flatten]] SliceCorrections addInterfaceCorrectionsOfSliceScheduled(
     const Model& m, const cohesive::Law& lawGiven, const Operators& ops, int k, const double* q, double* lambdaMax,
     InterfaceSchedule& schedule, double* wrench, long& evaluated) {
-  const double drift = schedule.drift, dueBelow = schedule.dueBelow;
+  const double drift = schedule.drift[k], dueBelow = schedule.allDue ? INFINITY : drift;
   SliceCorrections pass;
   if (schedule.sliceDue[k] > dueBelow) return pass;  // none due: all elastic, their forces in K_I q
   const cohesive::Law law = lawGiven;  // a local copy, as in addInterfaceWrenchesOfSlice
@@ -302,11 +303,37 @@ void computeStressRatiosForBeams(const Model& m, const Materials& mat, const Vec
   for (int e = 0; e < m.numBeams(); ++e) ratio[e] = beamBroken[e] ? 0.0 : stressOfBeam(m, mat, q, e) / mat.beamStrength[e];
 }
 
-// Every element afresh (drift 0, all due), or after a step that moved by `moved`: only those whose due drift
-// has come; each computed one gets its next due drift from its margin to 1 - kStressScheduleMargin.
+namespace {
+// A fresh schedule: drifts 0, every element due, and which pair of slices each element's drift follows.
+void startStressCheckSchedule(const Model& m, StressCheckSchedule& schedule) {
+  const int ne = m.numBeams();
+  schedule.drift = 0;
+  schedule.pairDrift.assign(std::max(0, m.numSlices - 1), 0.0);
+  schedule.pairOf.assign(ne, -1);
+  for (int e = 0; e < ne; ++e) {
+    const int a = m.nodeSlice[m.beamNodes[e][0]], b = m.nodeSlice[m.beamNodes[e][1]];
+    if (std::abs(a - b) == 1) schedule.pairOf[e] = std::min(a, b);
+  }
+  schedule.due.assign(ne, 0.0);
+}
+
+// After a step that moved by at most `moved` (and sliceMoved[k] in slice k, where given): every drift grows by
+// its bound; the 1e-6 covers the round-off of these running sums.
+void advanceStressCheckDrifts(double moved, const std::vector<double>& sliceMoved, StressCheckSchedule& schedule) {
+  schedule.drift += moved * (1.0 + 1e-6);
+  const bool perSlice = sliceMoved.size() == schedule.pairDrift.size() + 1;
+  for (std::size_t k = 0; k < schedule.pairDrift.size(); ++k)
+    schedule.pairDrift[k] += (perSlice ? std::max(sliceMoved[k], sliceMoved[k + 1]) : moved) * (1.0 + 1e-6);
+}
+}  // namespace
+
+// Every element afresh (drifts 0, all due), or after a step that moved by `moved` (`sliceMoved` per slice): only
+// those whose due drift has come; each computed one gets its next due drift from its margin to
+// 1 - kStressScheduleMargin.
 void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                const std::vector<std::uint8_t>& beamBroken, long step, double moved,
-                               StressCheckSchedule& schedule, std::vector<double>& ratio) {
+                               const std::vector<double>& sliceMoved, StressCheckSchedule& schedule,
+                               std::vector<double>& ratio) {
   const int ne = m.numBeams();
   if (mat.rodStress != RodStress::axial_bending || !std::isfinite(moved)) {  // no bound: compute them all
     computeStressRatiosForBeams(m, mat, q, beamBroken, ratio);
@@ -317,14 +344,15 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
     return;
   }
   if (schedule.step < 0 || step != schedule.step + 1 || static_cast<int>(schedule.due.size()) != ne) {
-    schedule.drift = 0;
-    schedule.due.assign(ne, 0.0);
+    startStressCheckSchedule(m, schedule);
     ratio.assign(ne, 0.0);
   } else {
-    schedule.drift += moved * (1.0 + 1e-6);  // the 1e-6 covers the round-off of this running sum
+    advanceStressCheckDrifts(moved, sliceMoved, schedule);
   }
   schedule.step = step;
-  const double drift = schedule.drift;
+  const double globalDrift = schedule.drift;
+  const double* pairDrift = schedule.pairDrift.data();
+  const int* pairOf = schedule.pairOf.data();
   double* due = schedule.due.data();
   long computed = 0;
   double largest = 0;
@@ -334,6 +362,7 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
       ratio[e] = 0.0;
       continue;
     }
+    const double drift = pairOf[e] < 0 ? globalDrift : pairDrift[pairOf[e]];
     if (due[e] > drift) continue;  // cannot have reached 1 - margin since its last computation
     const double strength = mat.beamStrength[e];
     const double r = stressOfBeam(m, mat, q, e) / strength;

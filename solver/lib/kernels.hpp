@@ -48,27 +48,29 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 /// mixed-mode law, cohesive::effectiveSeparation(law, .)). lambda moves by at most c |q change|_inf,
 /// c = max(1, 1/beta) sqrt(3) (2 + |rA,y| + |rA,z| + |rB,y| + |rB,z|) (lambda is max(1, 1/beta)-Lipschitz in the
 /// opening, whose components each move by at most their row's sum of |coefficients| times |q change|_inf): so
-/// an interface whose lambda was computed when the displacements' drift (as in StressCheckSchedule) stood at D
-/// need not see the law before the drift reaches D + ((1 - margin) lambdaTrack - lambda) / c. Every other
+/// an interface whose lambda was computed when its slice's drift (the sum over steps of a bound on the move of the
+/// slice's DOFs: an interface joins two nodes of its own slice) stood at D need not see the law before that drift
+/// reaches D + ((1 - margin) lambdaTrack - lambda) / c. Every other
 /// interface (due, or off the elastic branch) is evaluated by the law at every step, exactly as without the
 /// schedule: the histories, and so which interfaces are elastic, are the same, and the force of an interface
 /// depends only on q and its history (elasticForceOnB while elastic, the law's otherwise), never on the
 /// schedule: a fresh schedule (a restart) gives the same numbers. Scratch, not part of State.
 inline constexpr double kInterfaceScheduleMargin = 1e-4;
 struct InterfaceSchedule {
-  double drift = 0;           // bound on how far any DOF moved since the schedule started
-  double dueBelow = 0;        // this pass evaluates the interfaces with due <= dueBelow (drift, or all of them)
+  std::vector<double> drift;  // per slice: bound on how far any DOF of its nodes moved since the schedule started
+  bool allDue = false;        // this pass evaluates every interface (otherwise those with due <= their slice's drift)
   double largestRate = 0;     // max over interfaces of c
   std::vector<double> due;    // per interface: the drift from which the law must see it again
   std::vector<double> sliceDue;  // per slice: the smallest due of its interfaces (a slice with none due is skipped)
   long evaluated = 0;         // interfaces the last pass evaluated by the law
 };
 /// Before a pass at displacements that moved by at most `moved` (max over DOFs; infinite: start afresh) since the
-/// last one, with max |q| = `largestValue`: a fresh schedule (every interface due) when it has none of the
-/// model's size or `moved` is not finite; all due this pass (without restarting) when the round-off of an
-/// opening, 32 eps c |q|_inf, could reach a quarter of the margin, kInterfaceScheduleMargin lambdaTrack / 4.
+/// last one, and by at most sliceMoved[k] over the DOFs of slice k's nodes (empty: `moved` for every slice), with
+/// max |q| = `largestValue`: a fresh schedule (every interface due) when it has none of the model's size or
+/// `moved` is not finite; all due this pass (without restarting) when the round-off of an opening,
+/// 32 eps c |q|_inf, could reach a quarter of the margin, kInterfaceScheduleMargin lambdaTrack / 4.
 void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Operators& ops, double moved,
-                              double largestValue, InterfaceSchedule& schedule);
+                              const std::vector<double>& sliceMoved, double largestValue, InterfaceSchedule& schedule);
 /// The interfaces' elastic stiffness K_I in node blocks (groups kInterfaceGroups): the sum over interfaces of
 /// cohesive::elasticStiffness, so that K_I q is every interface's elastic force (f_iface of interfaces on the
 /// elastic branch: cohesive::elasticForceOnB, up to round-off). Block row R: its diagonal block (the interfaces
@@ -99,30 +101,37 @@ void computeStressRatiosForBeams(const Model& m, const Materials& mat, const Vec
                                  const std::vector<std::uint8_t>& beamBroken, std::vector<double>& ratio);
 
 /// The deletion check's schedule (rod_stress axial_bending): which rod elements need their stress computed.
-/// An element whose ratio r = sigma/sigma_ru was computed when the displacements' drift stood at D cannot
-/// reach 1 - kStressScheduleMargin while the drift (the sum over steps of a bound on max_i |q_i change|) stays
-/// below D + (1 - kStressScheduleMargin - r) sigma_ru / L (L = Materials::beamStressChangeBound of its ply):
-/// until then it cannot break, and its stress is not computed. Scratch, not part of State: a fresh schedule
-/// computes every element once, so a restarted run deletes the same elements as the run it continues.
+/// An element whose ratio r = sigma/sigma_ru was computed when its drift stood at D cannot reach
+/// 1 - kStressScheduleMargin while its drift stays below D + (1 - kStressScheduleMargin - r) sigma_ru / L
+/// (L = Materials::beamStressChangeBound of its ply): until then it cannot break, and its stress is not computed.
+/// An element's drift is the sum over steps of a bound on how far its 12 DOFs moved: for an element between
+/// slices k and k + 1, that of the pair (the larger of the two slices' moves); for any other (one spanning
+/// several slices in a reduced far field), or when the scheme gives no slice's move, the largest move of any DOF.
+/// Scratch, not part of State: a fresh schedule computes every element once, so a restarted run deletes the same
+/// elements as the run it continues.
 inline constexpr double kStressScheduleMargin = 1e-4;
 struct StressCheckSchedule {
   long step = -1;          // the step of the last check (-1: none); a check at any other step than the next starts afresh
   double drift = 0;        // bound on how far any DOF moved since the schedule started
-  std::vector<double> due; // per rod element: the drift from which its stress must be computed again
+  std::vector<double> pairDrift;  // per slice k: bound on how far any DOF of slices k and k + 1 moved since then
+  std::vector<int> pairOf; // per rod element: the k of its slices k, k + 1 (-1: it follows `drift`)
+  std::vector<double> due; // per rod element: its drift from which its stress must be computed again
   long computed = 0;       // elements computed at the last check
   double largestRatio = 0; // the largest ratio computed at the last check: an element at 1 - kStressScheduleMargin
                            // or above is computed at every check, so no ratio reaches 1 while this stays below
 };
 
 /// The deletion check at step `step`, the displacements having moved by at most `moved` (max over DOFs; infinite
-/// when the scheme gives no bound) since the check at step - 1: ratio[e] = sigma / sigma_ru of every intact rod
+/// when the scheme gives no bound) since the check at step - 1, and by at most sliceMoved[k] over the DOFs of
+/// slice k's nodes (empty where the scheme gives only `moved`): ratio[e] = sigma / sigma_ru of every intact rod
 /// element that could have reached 1 - kStressScheduleMargin (and of all of them when the schedule starts
 /// afresh, `moved` is infinite, or rod_stress is not axial_bending); an element not computed keeps its last
 /// ratio, below 1 - kStressScheduleMargin as its present one is; 0 for deleted ones. The same elements pass 1
 /// as with computeStressRatiosForBeams, with the same ratios.
 void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX& q,
                                const std::vector<std::uint8_t>& beamBroken, long step, double moved,
-                               StressCheckSchedule& schedule, std::vector<double>& ratio);
+                               const std::vector<double>& sliceMoved, StressCheckSchedule& schedule,
+                               std::vector<double>& ratio);
 
 /// Take rod element e out of K (its stiffness) and M (consistent minus lumped mass: its lumped mass stays).
 void removeBeamFromMatrices(const Model& m, const Materials& mat, int e, Operators& ops);

@@ -160,7 +160,7 @@ void bookEnergyOfDeletedBeam(const Model& m, const Materials& mat, int e, bool c
 void Simulation::checkRodStresses() {
   if (!materials.rodsBreakable) return;
   checkStressRatiosForBeams(model, materials, state.q, state.beamBroken, state.step, integrator->lastStepMoveBound(),
-                            stressSchedule_, beamStressRatio_);
+                            integrator->lastStepMoveBoundsOfSlices(), stressSchedule_, beamStressRatio_);
 }
 
 int Simulation::deleteOverloadedBeams() {

@@ -49,7 +49,7 @@ struct StepPhaseInfo {
 inline constexpr std::array<StepPhaseInfo, kStepPhaseCount> kStepPhases = {{
     {StepPhase::Advance, "advance", 0, "the scheme's step (Integrator::advance)"},
     {StepPhase::InterfaceSchedule, "interface schedule", 1,
-     "advanceInterfaceSchedule: the drift of the displacements, which interfaces may be due"},
+     "advanceInterfaceSchedule: each slice's drift of the displacements, which interfaces may be due"},
     {StepPhase::SlicePass, "slice pass", 1,
      "computeForcesAndAdvanceVelocities: the parallel pass over the slices, forces then velocities and positions"},
     {StepPhase::SliceInterfaces, "interfaces", 2,

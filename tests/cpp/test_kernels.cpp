@@ -69,6 +69,26 @@ int scheduledInterfaceForces(const Model& m, const cohesive::Law& law, const Ope
   return failed;
 }
 
+// Per slice, the largest |change| of its nodes' DOFs, as a move bound (x (1 + 1e-12) + 1e-300).
+std::vector<double> movesOfSlices(const Model& m, const VecX& change) {
+  std::vector<double> moved(m.numSlices, 0.0);
+  for (int node = 0; node < m.numNodes(); ++node)
+    for (int j = 0; j < 6; ++j) {
+      double& slice = moved[m.nodeSlice[node]];
+      slice = std::max(slice, std::abs(change[6 * node + j]));
+    }
+  for (double& x : moved) x = x * (1 + 1e-12) + 1e-300;
+  return moved;
+}
+
+// `field` scaled node by node by 0.25 + 0.75 x (its slice / the last slice): slices that move at different speeds.
+VecX rampedAlongSlices(const Model& m, const VecX& field) {
+  VecX out = field;
+  for (int node = 0; node < m.numNodes(); ++node)
+    out.segment<6>(6 * node) *= 0.25 + 0.75 * m.nodeSlice[node] / std::max(1.0, m.numSlices - 1.0);
+  return out;
+}
+
 }  // namespace
 
 // f_iface from the gather against the nodal wrenches of computeInterfaceForces summed interface by
@@ -112,17 +132,18 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
 // A factorisation that fails (H = M + dt/2 C made negative definite) throws SolverError, whose exit status
 // is run_failed (11), not out_of_range (7).
 // The scheduled deletion check (StressCheckSchedule) against the check of every element, along a path of
-// displacements that loads rods past their strength: at every step the same elements are at or above
-// 1 - margin with the same ratios bit for bit (so the same ones break; the schedule's largest ratio reaches 1
-// at the same steps as the full check's largest and then equals it), while most steps compute only a few
-// elements; a step that moved further than the scheme says would be unsafe, so a jump (q replaced) must be
-// given as an infinite move, and then every element is computed.
-TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
+// displacements that loads rods past their strength, its slices moving at different speeds: at every step the
+// same elements are at or above 1 - margin with the same ratios bit for bit (so the same ones break; the
+// schedule's largest ratio reaches 1 at the same steps as the full check's largest and then equals it), while
+// most steps compute only a few elements; a step that moved further than the scheme says would be unsafe, so a
+// jump (q replaced) must be given as an infinite move, and then every element is computed. `perSlice`: each
+// slice's own move is given (each element follows its pair of slices), otherwise only the largest.
+static void checkScheduledStressCheckFindsWhatTheFullCheckFinds(bool perSlice, long& computed) {
   Simulation sim(smallCase("integrator = \"lumped\"\n"));
   const Model& m = sim.model;
   const Materials& mat = sim.materials;
   const std::vector<std::uint8_t> broken(m.numBeams(), 0);
-  const VecX shape = pseudoRandomField(m.numDofs(), 1.0);
+  const VecX shape = rampedAlongSlices(m, pseudoRandomField(m.numDofs(), 1.0));
   // the amplitude at which the most stressed element of `shape` reaches its strength
   std::vector<double> full;
   computeStressRatiosForBeams(m, mat, shape, broken, full);
@@ -131,13 +152,14 @@ TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
   StressCheckSchedule schedule;
   std::vector<double> scheduled;
   const int steps = 400;
-  long computed = 0;
+  computed = 0;
   int overloadedSteps = 0;
   VecX qPrev = VecX::Zero(m.numDofs());
   for (int n = 1; n <= steps; ++n) {
     const VecX q = (1.2 * n / steps / unitRatio) * shape;  // passes ratio 1 at step ~333
     const double moved = (q - qPrev).cwiseAbs().maxCoeff();
-    checkStressRatiosForBeams(m, mat, q, broken, n, moved, schedule, scheduled);
+    const std::vector<double> sliceMoved = perSlice ? movesOfSlices(m, q - qPrev) : std::vector<double>{};
+    checkStressRatiosForBeams(m, mat, q, broken, n, moved, sliceMoved, schedule, scheduled);
     computeStressRatiosForBeams(m, mat, q, broken, full);
     computed += schedule.computed;
     bool anyOverloaded = false;
@@ -160,19 +182,70 @@ TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
   EXPECT_LT(computed, static_cast<long>(steps) * m.numBeams() / 4) << "the schedule skips most computations";
   // a jump given as infinite: every element computed, and equal to the full check
   const VecX jump = (0.5 / unitRatio) * shape;
-  checkStressRatiosForBeams(m, mat, jump, broken, steps + 1, INFINITY, schedule, scheduled);
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 1, INFINITY, {}, schedule, scheduled);
   computeStressRatiosForBeams(m, mat, jump, broken, full);
   EXPECT_EQ(schedule.computed, m.numBeams());
   EXPECT_EQ(scheduled, full);
   // after it the schedule starts afresh (all), then skips (nothing moved); a check that is not the next
   // step's starts afresh again
-  checkStressRatiosForBeams(m, mat, jump, broken, steps + 2, 0.0, schedule, scheduled);
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 2, 0.0, {}, schedule, scheduled);
   EXPECT_EQ(schedule.computed, m.numBeams());
-  checkStressRatiosForBeams(m, mat, jump, broken, steps + 3, 0.0, schedule, scheduled);
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 3, 0.0, {}, schedule, scheduled);
   EXPECT_LT(schedule.computed, m.numBeams() / 4);
-  checkStressRatiosForBeams(m, mat, jump, broken, steps + 9, 0.0, schedule, scheduled);
+  checkStressRatiosForBeams(m, mat, jump, broken, steps + 9, 0.0, {}, schedule, scheduled);
   EXPECT_EQ(schedule.computed, m.numBeams());
   EXPECT_EQ(scheduled, full);
+}
+
+TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
+  long global = 0, perSlice = 0;
+  checkScheduledStressCheckFindsWhatTheFullCheckFinds(false, global);
+  checkScheduledStressCheckFindsWhatTheFullCheckFinds(true, perSlice);
+  EXPECT_LT(perSlice, global) << "slices that move less are computed less often";
+}
+
+// Each element follows the drift of its own two slices: when only the nodes of one slice move, only the elements
+// that reach that slice are ever computed (after the fresh start), however far it moves; given only the largest
+// move, elements everywhere come due.
+TEST(Kernels, ScheduledStressCheckFollowsEachSlicesMove) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  const Model& m = sim.model;
+  const Materials& mat = sim.materials;
+  const std::vector<std::uint8_t> broken(m.numBeams(), 0);
+  const VecX shape = pseudoRandomField(m.numDofs(), 1.0);
+  std::vector<double> full;
+  computeStressRatiosForBeams(m, mat, shape, broken, full);
+  const double unitRatio = *std::max_element(full.begin(), full.end());
+  const int moving = m.numSlices / 2;
+  VecX wobble = VecX::Zero(m.numDofs());
+  for (int node = sim.ops.sliceNodeStart[moving]; node < sim.ops.sliceNodeStart[moving + 1]; ++node)
+    wobble.segment<6>(6 * node) = shape.segment<6>(6 * node);
+  for (bool perSlice : {true, false}) {
+    StressCheckSchedule schedule;
+    std::vector<double> ratio;
+    std::vector<char> everComputed(m.numBeams(), 0);
+    VecX qPrev = (0.5 / unitRatio) * shape;
+    checkStressRatiosForBeams(m, mat, qPrev, broken, 1, 0.0, {}, schedule, ratio);  // a fresh schedule: all
+    for (int n = 2; n <= 200; ++n) {
+      const VecX q = (0.5 / unitRatio) * shape + (0.4 / unitRatio) * std::sin(0.1 * n) * wobble;
+      std::fill(ratio.begin(), ratio.end(), -1.0);  // an element the check computes gets its ratio, >= 0
+      checkStressRatiosForBeams(m, mat, q, broken, n, (q - qPrev).cwiseAbs().maxCoeff() * (1 + 1e-12) + 1e-300,
+                                perSlice ? movesOfSlices(m, q - qPrev) : std::vector<double>{}, schedule, ratio);
+      for (int e = 0; e < m.numBeams(); ++e) everComputed[e] |= ratio[e] >= 0;
+      qPrev = q;
+    }
+    int reaching = 0, elsewhere = 0;
+    for (int e = 0; e < m.numBeams(); ++e) {
+      if (!everComputed[e]) continue;
+      const int a = m.nodeSlice[m.beamNodes[e][0]], b = m.nodeSlice[m.beamNodes[e][1]];
+      (a == moving || b == moving ? reaching : elsewhere) += 1;
+    }
+    EXPECT_GT(reaching, 0) << (perSlice ? "per slice" : "largest move only");
+    if (perSlice)
+      EXPECT_EQ(elsewhere, 0) << "an element away from the moving slice was computed";
+    else
+      EXPECT_GT(elsewhere, 0) << "with only the largest move, every element follows it";
+  }
 }
 
 // The elastic force of an interface (cohesive::elasticForceOnB, what the scheduled pass uses while the secant
@@ -203,12 +276,14 @@ TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
 // same histories and failed counts as evaluating every interface by the law, forces within round-off of it (and of the elastic blocks' tolerance, kInterfaceBlockTolerance);
 // a schedule started afresh part-way (a restart) gives the same forces bit for bit; no thread count matters.
 // `keys`: further case keys (the mixed-mode law's shear_strength_ratio, whose lambda weighs shear by 1/beta^2).
-static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
+// The slices move at different speeds; `perSlice`: each slice's own move is given, otherwise only the largest.
+// `evaluated`: the interfaces the law saw, over the path.
+static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys, bool perSlice, long& evaluated) {
   Simulation sim(smallCase("integrator = \"lumped\"\n" + keys));
   const Model& m = sim.model;
   const cohesive::Law& law = sim.materials.law;
   const int n = m.numDofs();
-  const VecX shape = pseudoRandomField(n, 1.0), wobble = pseudoRandomField(n, 1.0).reverse();
+  const VecX shape = rampedAlongSlices(m, pseudoRandomField(n, 1.0)), wobble = pseudoRandomField(n, 1.0).reverse();
   std::vector<double> lmLaw(m.numInterfaces(), 0.0), lmSched = lmLaw, lmFresh = lmLaw;
   InterfaceSchedule sched, fresh;
   VecX before = VecX::Zero(n), fLaw, fSched, fFresh;
@@ -217,17 +292,18 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
   for (const auto& g : sim.ops.ifacePacked)
     elasticScale = std::max(elasticScale, law.k * g.area * (2 + std::abs(g.armAy) + std::abs(g.armAz) +
                                                               std::abs(g.armBy) + std::abs(g.armBz)));
-  long evaluated = 0;
+  evaluated = 0;
   const int steps = 400, restartAt = 250, threads = omp_get_max_threads();
   for (int t = 0; t <= steps; ++t) {
     const double a = 15.0 * law.delta0() * std::sin(M_PI * t / steps);  // out to 15 delta0 and back
     const VecX q = a * shape + 0.05 * law.delta0() * std::cos(0.3 * t) * wobble;
     const double moved = t == 0 ? INFINITY : (q - before).cwiseAbs().maxCoeff() * (1 + 1e-12) + 1e-300;
+    const std::vector<double> sliceMoved = perSlice ? movesOfSlices(m, q - before) : std::vector<double>{};
     before = q;
     omp_set_num_threads(1 + t % 2);
     if (t == restartAt) lmFresh = lmSched;
     const int failedLaw = computeForcesForInterfaces(m, law, sim.ops, q, lmLaw, true, fLaw);
-    advanceInterfaceSchedule(m, law, sim.ops, moved, q.cwiseAbs().maxCoeff(), sched);
+    advanceInterfaceSchedule(m, law, sim.ops, moved, sliceMoved, q.cwiseAbs().maxCoeff(), sched);
     const int failedSched = scheduledInterfaceForces(m, law, sim.ops, KI, q, lmSched, sched, fSched);
     evaluated += sched.evaluated;
     ASSERT_EQ(failedSched, failedLaw) << "step " << t;
@@ -239,7 +315,8 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
               1e-12 * fLaw.cwiseAbs().maxCoeff() + 64 * kInterfaceBlockTolerance * elasticScale * q.cwiseAbs().maxCoeff())
         << "step " << t;
     if (t >= restartAt) {  // lmFresh holds the histories before this step's update, as a checkpoint would
-      advanceInterfaceSchedule(m, law, sim.ops, t == restartAt ? INFINITY : moved, q.cwiseAbs().maxCoeff(), fresh);
+      advanceInterfaceSchedule(m, law, sim.ops, t == restartAt ? INFINITY : moved, sliceMoved, q.cwiseAbs().maxCoeff(),
+                               fresh);
       scheduledInterfaceForces(m, law, sim.ops, KI, q, lmFresh, fresh, fFresh);
       ASSERT_EQ(fFresh, fSched) << "step " << t;
       ASSERT_EQ(lmFresh, lmSched) << "step " << t;
@@ -252,13 +329,21 @@ static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys) {
   EXPECT_LT(evaluated, static_cast<long>(steps + 1) * m.numInterfaces()) << "the schedule should skip some";
 }
 
-TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) { checkScheduledInterfacePassFollowsTheLaw(""); }
+// Per slice the law sees fewer interfaces than with the largest move alone, and follows it all the same.
+static void checkScheduledInterfacePassBothWays(const std::string& keys) {
+  long global = 0, perSlice = 0;
+  checkScheduledInterfacePassFollowsTheLaw(keys, false, global);
+  checkScheduledInterfacePassFollowsTheLaw(keys, true, perSlice);
+  EXPECT_LT(perSlice, global) << "slices that move less are seen by the law less often";
+}
+
+TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) { checkScheduledInterfacePassBothWays(""); }
 // A weak shear (beta < 1) makes lambda grow faster than the opening's norm: the schedule must bound that.
 TEST(Kernels, ScheduledInterfacePassFollowsTheMixedModeLawWeakShear) {
-  checkScheduledInterfacePassFollowsTheLaw("shear_strength_ratio = 0.5\n");
+  checkScheduledInterfacePassBothWays("shear_strength_ratio = 0.5\n");
 }
 TEST(Kernels, ScheduledInterfacePassFollowsTheMixedModeLawStrongShear) {
-  checkScheduledInterfacePassFollowsTheLaw("shear_strength_ratio = 2\n");
+  checkScheduledInterfacePassBothWays("shear_strength_ratio = 2\n");
 }
 
 // K in node blocks (node_blocks.hpp) against Eigen's sparse product: the rods lie in xy-planes, so the model's
@@ -428,6 +513,12 @@ TEST(Kernels, LumpedStepMovesPositionsByDtTimesTheHalfStepVelocity) {
       const double bound = std::max(largestStep, largestShape * std::abs(U1 - U0)) * (1.0 + 1e-12) + std::ldexp(largest, -52);
       EXPECT_GE(sim.integrator->lastStepMoveBound(), moved) << "step " << n;
       EXPECT_EQ(sim.integrator->lastStepMoveBound(), bound) << "step " << n;
+      // per slice: each holds its own DOFs' moves, and the largest is the global bound
+      const std::vector<double>& ofSlices = sim.integrator->lastStepMoveBoundsOfSlices();
+      ASSERT_EQ(static_cast<int>(ofSlices.size()), sim.model.numSlices);
+      const std::vector<double> exact = movesOfSlices(sim.model, s.q - q0);
+      for (int k = 0; k < sim.model.numSlices; ++k) EXPECT_GE(ofSlices[k] * (1 + 1e-12) + 1e-300, exact[k]) << "slice " << k;
+      EXPECT_EQ(*std::max_element(ofSlices.begin(), ofSlices.end()), bound) << "step " << n;
     }
     qAt.push_back(s.q);
     vAt.push_back(s.vHalf);

@@ -179,7 +179,7 @@ class LumpedIntegrator : public Integrator {
     PhaseLaps laps(timers_);
     gatherGrips(ops, s.vHalf, vGripBefore_);  // v_{n-1/2} of the grips, for their reactions
     laps.lap(StepPhase::GripsAndWork);
-    advanceInterfaceSchedule(m, mat.law, ops, moveBound_, largestValue_, ifaceSchedule_);
+    advanceInterfaceSchedule(m, mat.law, ops, moveBound_, sliceMoveBound_, largestValue_, ifaceSchedule_);
     laps.lap(StepPhase::InterfaceSchedule);
     s.failedInterfaces = computeForcesAndAdvanceVelocities(m, mat, ops, s);
     laps.lap(StepPhase::SlicePass);
@@ -192,11 +192,13 @@ class LumpedIntegrator : public Integrator {
     const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
     moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
+    boundMovesOfSlices(move, Ubefore, s.appliedDisplacement);
     largestValue_ = std::max(move.largestValue, largestShape_ * std::abs(s.appliedDisplacement));  // >= max |q_{n+1}|
     laps.lap(StepPhase::ClockAndGrips);
   }
 
   double lastStepMoveBound() const override { return moveBound_; }
+  const std::vector<double>& lastStepMoveBoundsOfSlices() const override { return sliceMoveBound_; }
   const InterfaceSchedule* interfaceSchedule() const override { return &ifaceSchedule_; }
 
   void initialise(const Model& m, const Materials& mat, const Operators& ops, State& s) override {
@@ -341,10 +343,24 @@ class LumpedIntegrator : public Integrator {
     return std::max(move.largestStep, grips) * (1.0 + 1e-12) + std::ldexp(largest, -52);
   }
 
+  // Per slice, boundOfMove's bound over its own DOFs: its free DOFs' largest |dt v|, or the grips' move (every
+  // grip's, wherever it is), and the same round-off terms (of the largest |q| anywhere). Each is at most
+  // boundOfMove's, and the largest of them equals it.
+  void boundMovesOfSlices(const PositionMove& move, double Ubefore, double Uafter) {
+    const double grips = largestShape_ * std::abs(Uafter - Ubefore);
+    const double largest = std::max({move.largestValue, largestShape_ * std::abs(Uafter), largestShape_ * std::abs(Ubefore)});
+    sliceMoveBound_.resize(sliceSums_.size());
+    for (std::size_t k = 0; k < sliceSums_.size(); ++k) {
+      const double step = std::max(sliceSums_[k].largestStep[0], sliceSums_[k].largestStep[1]);
+      sliceMoveBound_[k] = std::max(step, grips) * (1.0 + 1e-12) + std::ldexp(largest, -52);
+    }
+  }
+
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
   double largestShape_ = 0;          // max |shape| of the prescribed DOFs
   double moveBound_ = INFINITY;      // lastStepMoveBound (infinite: q was set otherwise, the schedules start afresh)
   double largestValue_ = INFINITY;   // a bound on max |q_n|
+  std::vector<double> sliceMoveBound_;  // lastStepMoveBoundsOfSlices: per slice, the move bound of its DOFs
   InterfaceSchedule ifaceSchedule_;  // which interfaces the law must see (kernels.hpp)
   VecX mass_, invMass_, fI_, vNext_, qNext_, vGripBefore_, vGrip_;
   std::vector<SliceSums> sliceSums_;  // per slice
