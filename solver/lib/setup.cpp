@@ -1,7 +1,5 @@
 #include "setup.hpp"
 
-#include <dlfcn.h>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -206,13 +204,6 @@ State stateAtRest(const Model& m, const Operators& ops) {
   s.beamBroken.assign(m.numBeams(), 0);
   s.reaction = VecX::Zero(ops.prescribedDofs.size());
   return s;
-}
-
-/// The BLAS's own thread count, where the BLAS linked at run time has one (OpenBLAS's pthread build, Debian's
-/// default, starts one thread per core whatever OpenMP is told): CHOLMOD's factorizations and solves use it.
-static void setBlasThreadCount(int n) {
-  using SetThreads = void (*)(int);
-  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(n);
 }
 
 void setThreadCount(const CaseParams& p, int numDofs) {

@@ -1,5 +1,7 @@
 #include "static_solve.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -9,6 +11,28 @@
 #include "kernels.hpp"
 
 namespace enamel {
+
+void setBlasThreadCount(int n) {
+  using SetThreads = void (*)(int);
+  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(n);
+}
+
+int blasThreadCount() {
+  using GetThreads = int (*)();
+  auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  return get ? get() : 0;
+}
+
+namespace {
+// The BLAS at one thread while this lives, its count before restored after.
+struct OneBlasThread {
+  const int before = blasThreadCount();
+  OneBlasThread() { if (before > 1) setBlasThreadCount(1); }
+  ~OneBlasThread() { if (before > 1) setBlasThreadCount(before); }
+  OneBlasThread(const OneBlasThread&) = delete;
+  OneBlasThread& operator=(const OneBlasThread&) = delete;
+};
+}  // namespace
 
 void addElementTriplets(std::vector<Eigen::Triplet<double>>& trip, const beam::Mat12& Ke, int a, int b) {
   const int dof[2] = {6 * a, 6 * b};
@@ -38,6 +62,7 @@ VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const s
     }
   SpMat Kff(nf, nf);
   Kff.setFromTriplets(tff.begin(), tff.end());
+  const OneBlasThread oneThread;
   Eigen::CholmodSupernodalLLT<SpMat> chol;
   chol.cholmod().print = 0;  // a factorisation that fails is handled below, not printed
   chol.compute(Kff);

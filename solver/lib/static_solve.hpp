@@ -9,9 +9,18 @@
 
 namespace enamel {
 
+/// The BLAS's own thread count, where the BLAS linked at run time has one (OpenBLAS's pthread build, Debian's
+/// default, starts one thread per core whatever OpenMP is told): CHOLMOD's factorizations and solves use it.
+/// blasThreadCount is 0 where the BLAS has none.
+void setBlasThreadCount(int n);
+int blasThreadCount();
+
 /// Static solution of K u = 0 with u prescribed (= values) at `dofs` (CHOLMOD on the free partition). Where
 /// the free partition is only semi-definite (a mechanism: a part free to move without straining anything),
-/// the mechanism stays where it is and `mechanism`, if given, is set.
+/// the mechanism stays where it is and `mechanism`, if given, is set. The BLAS runs at one thread for it, so that
+/// the solution does not depend on the thread count: OpenBLAS's threaded kernels add in another order on some
+/// CPUs (on an Intel Xeon with AVX-512, 2026-12-07, the transverse modulus differed in its last ~10 ulps between
+/// one and two threads, and with it every later number of a run).
 VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values,
                            bool* mechanism = nullptr);
 

@@ -17,6 +17,7 @@
 #include "node_blocks.hpp"
 #include "runner.hpp"
 #include "simulation.hpp"
+#include "static_solve.hpp"
 
 using namespace enamel;
 
@@ -645,6 +646,26 @@ TEST(Kernels, StaticSolveKeepsAMechanismInPlace) {
 }
 
 // Nothing to start before: with unbreakable interfaces and rods U_c is infinite; refused as bad input (7).
+// The static solves run the BLAS at one thread whatever its count (solveStaticPrescribed), and give its count back:
+// the transverse modulus (a static solve on a block of the case) is the same, bit for bit, with the BLAS at one
+// thread or two. On the CPUs where OpenBLAS's threaded kernels add in another order this is what keeps a run's
+// numbers independent of the thread count (tests/python/test_threads.py checks whole runs).
+TEST(Kernels, StaticSolveDoesNotDependOnTheBlasThreadCount) {
+  const int before = blasThreadCount();
+  if (before == 0) GTEST_SKIP() << "the BLAS linked here has no thread count";
+  // the block measureTransverseModulus uses at its largest, 24 x 12 d: OpenBLAS threads only large enough products
+  const CaseParams p = parseCase("theta_D = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\n"
+                                 "w_s_over_d = 24\nh_s_over_d = 12\n", "kernels", "", {});
+  std::vector<double> modulus;
+  for (int threads : {1, 2}) {
+    setBlasThreadCount(threads);
+    modulus.push_back(measureTransverseModulus(p));
+    EXPECT_EQ(blasThreadCount(), threads) << "the solve gives the BLAS its count back";
+  }
+  setBlasThreadCount(before);
+  EXPECT_EQ(modulus[0], modulus[1]);
+}
+
 TEST(Kernels, StaticStartWithoutDamageIsRefused) {
   Simulation sim(smallCase("integrator = \"lumped\"\ninterfaces_breakable = false\nrods_breakable = false\n"));
   try {
