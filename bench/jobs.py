@@ -120,7 +120,12 @@ def completed(out: pathlib.Path) -> bool:
 
 def done(out: pathlib.Path) -> bool:
     """A complete result whose record has its pieces."""
-    return completed(out) and bool(read_record(out).get("pieces"))
+    return _done(read_record(out), completed(out))
+
+
+def _done(rec: dict, complete: bool) -> bool:
+    """done() of a record and a result's completeness already read."""
+    return complete and bool(rec.get("pieces"))
 
 
 def prepare(out: pathlib.Path, command: list[str], digest: str) -> bool:
@@ -129,7 +134,7 @@ def prepare(out: pathlib.Path, command: list[str], digest: str) -> bool:
     started over: record, results and checkpoint removed. Otherwise (a stopped run) it continues."""
     rec, complete = read_record(out), completed(out)
     same = rec.get("command") == command and rec.get("solver_sha256") == digest
-    if same and complete and rec.get("pieces"):
+    if same and _done(rec, complete):
         return False
     if not same or complete:
         for name in (RECORD, *paths.RESULT_NAMES.values(), "checkpoint.bin"):

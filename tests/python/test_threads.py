@@ -45,10 +45,11 @@ def test_two_threads_give_the_one_thread_result(variant, run, tmp_path, monkeypa
     monkeypatch.setenv("OMP_WAIT_POLICY", "passive")
     results = {}
     for threads in (1, 2):
-        if variant in BLAS_AT_ONE_THREAD and threads == 1:
-            monkeypatch.setenv("OPENBLAS_NUM_THREADS", "1")
-        else:
-            monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+        if variant in BLAS_AT_ONE_THREAD:  # the 1-thread run's BLAS at one thread, the 2-thread run's at its default
+            if threads == 1:
+                monkeypatch.setenv("OPENBLAS_NUM_THREADS", "1")
+            else:
+                monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
         out = tmp_path / f"t{threads}"
         args = ["run", CASE, "--preset", "ci", "--out", out, "--quiet", "--set", f"threads={threads}"]
         for s in SETS[variant]:

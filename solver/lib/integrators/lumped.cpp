@@ -79,9 +79,9 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
   return std::sqrt(std::max(lambda, 0.0));
 }
 
-// What the node pass's position update moved: the largest |dt v_i| added and the largest |q_i| after it.
+// What the node pass's position update moved: the largest |q_i| after it (the largest |dt v_i| is kept per slice).
 struct PositionMove {
-  double largestStep = 0, largestValue = 0;
+  double largestValue = 0;
 };
 
 // The wrench of a slice whose interfaces the law did not see (all elastic: their forces are in K_I q).
@@ -191,8 +191,7 @@ class LumpedIntegrator : public Integrator {
     advanceClock(mat.loading, s, dt_);
     const double Ubefore = s.appliedDisplacement;
     prescribeDisplacements(ops, mat.loading, s);
-    moveBound_ = boundOfMove(move, Ubefore, s.appliedDisplacement);
-    boundMovesOfSlices(move, Ubefore, s.appliedDisplacement);
+    moveBound_ = boundMovesOfSlices(move, Ubefore, s.appliedDisplacement);
     largestValue_ = std::max(move.largestValue, largestShape_ * std::abs(s.appliedDisplacement));  // >= max |q_{n+1}|
     laps.lap(StepPhase::ClockAndGrips);
   }
@@ -327,33 +326,28 @@ class LumpedIntegrator : public Integrator {
   // What the node pass's q_{n+1} = q_n + dt v_{n+1/2} moved (it has replaced q_n and v_{n-1/2} already)
   PositionMove moveOfStep() const {
     PositionMove move;
-    for (const SliceSums& k : sliceSums_) {  // maxima: exact in any order
-      move.largestStep = std::max({move.largestStep, k.largestStep[0], k.largestStep[1]});
+    for (const SliceSums& k : sliceSums_)  // maxima: exact in any order
       move.largestValue = std::max({move.largestValue, k.largestValue[0], k.largestValue[1]});
-    }
     return move;
   }
 
-  // max_i |q_{n+1,i} - q_{n,i}|: a free DOF moved by fl(q + dt v) - q, at most |dt v| plus half an ulp of the
-  // result; a grip by shape (U_{n+1} - U_n) plus the round-off of both products. So the larger of the two moves,
-  // plus 2^-52 of the largest |q| (an ulp), with a relative 1e-12 for the products.
-  double boundOfMove(const PositionMove& move, double Ubefore, double Uafter) const {
-    const double grips = largestShape_ * std::abs(Uafter - Ubefore);
-    const double largest = std::max({move.largestValue, largestShape_ * std::abs(Uafter), largestShape_ * std::abs(Ubefore)});
-    return std::max(move.largestStep, grips) * (1.0 + 1e-12) + std::ldexp(largest, -52);
-  }
-
-  // Per slice, boundOfMove's bound over its own DOFs: its free DOFs' largest |dt v|, or the grips' move (every
-  // grip's, wherever it is), and the same round-off terms (of the largest |q| anywhere). Each is at most
-  // boundOfMove's, and the largest of them equals it.
-  void boundMovesOfSlices(const PositionMove& move, double Ubefore, double Uafter) {
+  // Per slice k, max_i |q_{n+1,i} - q_{n,i}| over its DOFs (into sliceMoveBound_), and returned the largest of
+  // them, the bound over all DOFs (rounding is monotone, so it equals the same formula on the maxima over slices):
+  // a free DOF moved by fl(q + dt v) - q, at most |dt v| plus half an ulp of the result; a grip by
+  // shape (U_{n+1} - U_n) plus the round-off of both products (every grip's, wherever it is). So the larger of the
+  // slice's largest |dt v| and the grips' move, plus 2^-52 of the largest |q| anywhere (an ulp), with a relative
+  // 1e-12 for the products.
+  double boundMovesOfSlices(const PositionMove& move, double Ubefore, double Uafter) {
     const double grips = largestShape_ * std::abs(Uafter - Ubefore);
     const double largest = std::max({move.largestValue, largestShape_ * std::abs(Uafter), largestShape_ * std::abs(Ubefore)});
     sliceMoveBound_.resize(sliceSums_.size());
+    double bound = 0;
     for (std::size_t k = 0; k < sliceSums_.size(); ++k) {
       const double step = std::max(sliceSums_[k].largestStep[0], sliceSums_[k].largestStep[1]);
       sliceMoveBound_[k] = std::max(step, grips) * (1.0 + 1e-12) + std::ldexp(largest, -52);
+      bound = std::max(bound, sliceMoveBound_[k]);
     }
+    return bound;
   }
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
