@@ -163,6 +163,12 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
     schedule.drift.assign(m.numSlices, 0.0);
     schedule.due.assign(m.numInterfaces(), 0.0);
     schedule.sliceDue.assign(m.numSlices, 0.0);
+    schedule.sliceChunkStart.assign(m.numSlices + 1, 0);
+    for (int k = 0; k < m.numSlices; ++k) {
+      const int interfaces = ops.sliceIfaceStart[k + 1] - ops.sliceIfaceStart[k];
+      schedule.sliceChunkStart[k + 1] = schedule.sliceChunkStart[k] + (interfaces + kInterfaceChunk - 1) / kInterfaceChunk;
+    }
+    schedule.chunkDue.assign(schedule.sliceChunkStart[m.numSlices], 0.0);
     schedule.largestRate = 0;
     for (const auto& g : ops.ifacePacked) schedule.largestRate = std::max(schedule.largestRate, separationRate(law, g));
   } else {
@@ -219,16 +225,29 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
   const auto* nodes = m.ifaceNodes.data();
   const cohesive::SliceInterface* packed = ops.ifacePacked.data();
   double* due = schedule.due.data();
+  double* chunkDue = schedule.chunkDue.data();
   double sliceDue = INFINITY;
-  for (int i = first; i < last; ++i) {
-    if (due[i] <= dueBelow) {  // otherwise elastic, and its force is in K_I q
-      const int A = nodes[i][0], B = nodes[i][1];
-      cohesive::Vec3 correction;
-      ++evaluated;
-      if (evaluateDueInterface(law, packed[i], q + 6 * A, q + 6 * B, drift, lambdaMax[i], due[i], pass.failed, correction))
-        addWrenchesOfForce(packed[i], correction, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+  for (int c = schedule.sliceChunkStart[k], i = first; c < schedule.sliceChunkStart[k + 1]; ++c) {
+    const int end = std::min(last, i + kInterfaceChunk);
+    if (chunkDue[c] > dueBelow) {  // none due: all elastic
+      sliceDue = std::min(sliceDue, chunkDue[c]);
+      i = end;
+      continue;
     }
-    sliceDue = std::min(sliceDue, due[i]);
+    ++pass.chunks;
+    double smallest = INFINITY;
+    for (; i < end; ++i) {
+      if (due[i] <= dueBelow) {  // otherwise elastic, and its force is in K_I q
+        const int A = nodes[i][0], B = nodes[i][1];
+        cohesive::Vec3 correction;
+        ++evaluated;
+        if (evaluateDueInterface(law, packed[i], q + 6 * A, q + 6 * B, drift, lambdaMax[i], due[i], pass.failed, correction))
+          addWrenchesOfForce(packed[i], correction, wrench + 6 * (A - firstNode), wrench + 6 * (B - firstNode));
+      }
+      smallest = std::min(smallest, due[i]);
+    }
+    chunkDue[c] = smallest;
+    sliceDue = std::min(sliceDue, smallest);
   }
   schedule.sliceDue[k] = sliceDue;
   return pass;
@@ -315,6 +334,27 @@ void startStressCheckSchedule(const Model& m, StressCheckSchedule& schedule) {
     if (std::abs(a - b) == 1) schedule.pairOf[e] = std::min(a, b);
   }
   schedule.due.assign(ne, 0.0);
+  const int chunks = (ne + kStressCheckChunk - 1) / kStressCheckChunk;
+  schedule.chunkDue.assign(chunks, 0.0);
+  schedule.chunkPairs.assign(2 * static_cast<std::size_t>(chunks), 0);
+  schedule.chunkFollowsDrift.assign(chunks, 0);
+  for (int c = 0; c < chunks; ++c) {
+    int first = std::numeric_limits<int>::max(), last = -1;
+    for (int e = c * kStressCheckChunk; e < std::min(ne, (c + 1) * kStressCheckChunk); ++e) {
+      const int pair = schedule.pairOf[e];
+      if (pair < 0) schedule.chunkFollowsDrift[c] = 1;
+      else first = std::min(first, pair), last = std::max(last, pair);
+    }
+    schedule.chunkPairs[2 * c] = first, schedule.chunkPairs[2 * c + 1] = last;
+  }
+}
+
+// The largest drift any element of chunk c follows.
+double driftOfChunk(const StressCheckSchedule& schedule, int c) {
+  double drift = schedule.chunkFollowsDrift[c] ? schedule.drift : 0.0;
+  for (int pair = schedule.chunkPairs[2 * c]; pair <= schedule.chunkPairs[2 * c + 1]; ++pair)
+    drift = std::max(drift, schedule.pairDrift[pair]);
+  return drift;
 }
 
 // After a step that moved by at most `moved` (and sliceMoved[k] in slice k, where given): every drift grows by
@@ -354,25 +394,35 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
   const double* pairDrift = schedule.pairDrift.data();
   const int* pairOf = schedule.pairOf.data();
   double* due = schedule.due.data();
-  long computed = 0;
+  long computed = 0, visited = 0;
   double largest = 0;
-#pragma omp parallel for schedule(static) reduction(+ : computed) reduction(max : largest)
-  for (int e = 0; e < ne; ++e) {
-    if (beamBroken[e]) {
-      ratio[e] = 0.0;
-      continue;
+  const int chunks = static_cast<int>(schedule.chunkDue.size());
+#pragma omp parallel for schedule(static) reduction(+ : computed, visited) reduction(max : largest)
+  for (int c = 0; c < chunks; ++c) {
+    if (schedule.chunkDue[c] > driftOfChunk(schedule, c)) continue;  // none of its elements is due
+    ++visited;
+    double chunkDue = INFINITY;
+    for (int e = c * kStressCheckChunk; e < std::min(ne, (c + 1) * kStressCheckChunk); ++e) {
+      if (beamBroken[e]) {  // it broke after the check that made its chunk due, so its chunk is read
+        ratio[e] = 0.0;
+        continue;
+      }
+      const double drift = pairOf[e] < 0 ? globalDrift : pairDrift[pairOf[e]];
+      if (due[e] <= drift) {  // otherwise it cannot have reached 1 - margin since its last computation
+        const double strength = mat.beamStrength[e];
+        const double r = stressOfBeam(m, mat, q, e) / strength;
+        ratio[e] = r;
+        largest = std::max(largest, r);
+        due[e] = drift + std::max(0.0, 1.0 - kStressScheduleMargin - r) * strength /
+                             mat.beamStressChangeBound[m.beamClass(e)];
+        ++computed;
+      }
+      if (!(due[e] >= chunkDue)) chunkDue = due[e];  // (a NaN due keeps the chunk due)
     }
-    const double drift = pairOf[e] < 0 ? globalDrift : pairDrift[pairOf[e]];
-    if (due[e] > drift) continue;  // cannot have reached 1 - margin since its last computation
-    const double strength = mat.beamStrength[e];
-    const double r = stressOfBeam(m, mat, q, e) / strength;
-    ratio[e] = r;
-    largest = std::max(largest, r);
-    due[e] = drift + std::max(0.0, 1.0 - kStressScheduleMargin - r) * strength /
-                         mat.beamStressChangeBound[m.beamClass(e)];
-    ++computed;
+    schedule.chunkDue[c] = chunkDue;
   }
   schedule.computed = computed;
+  schedule.visitedChunks = visited;
   schedule.largestRatio = largest;
 }
 

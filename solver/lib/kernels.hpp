@@ -56,12 +56,18 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 /// depends only on q and its history (elasticForceOnB while elastic, the law's otherwise), never on the
 /// schedule: a fresh schedule (a restart) gives the same numbers. Scratch, not part of State.
 inline constexpr double kInterfaceScheduleMargin = 1e-4;
+inline constexpr int kInterfaceChunk = 64;
 struct InterfaceSchedule {
   std::vector<double> drift;  // per slice: bound on how far any DOF of its nodes moved since the schedule started
   bool allDue = false;        // this pass evaluates every interface (otherwise those with due <= their slice's drift)
   double largestRate = 0;     // max over interfaces of c
   std::vector<double> due;    // per interface: the drift from which the law must see it again
   std::vector<double> sliceDue;  // per slice: the smallest due of its interfaces (a slice with none due is skipped)
+  // Each slice's interfaces in chunks of kInterfaceChunk consecutive ones (the last of a slice may be shorter): a
+  // chunk with none due is skipped whole, without reading its interfaces.
+  std::vector<int> sliceChunkStart;  // per slice k: its first chunk (sliceChunkStart[numSlices]: the number of chunks)
+  std::vector<double> chunkDue;      // per chunk: the smallest due of its interfaces
+  long visitedChunks = 0;            // chunks the last pass read (the sum of SliceCorrections::chunks)
   long evaluated = 0;         // interfaces the last pass evaluated by the law
 };
 /// Before a pass at displacements that moved by at most `moved` (max over DOFs; infinite: start afresh) since the
@@ -89,6 +95,7 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
 struct SliceCorrections {
   int failed = 0;       // failed interfaces of the slice
   bool wrench = false;  // the wrench was written (otherwise it is zero, and left as it was)
+  int chunks = 0;       // chunks of interfaces read (InterfaceSchedule::chunkDue)
 };
 SliceCorrections addInterfaceCorrectionsOfSliceScheduled(const Model& m, const cohesive::Law& law, const Operators& ops, int k,
                                             const double* q, double* lambdaMax, InterfaceSchedule& schedule,
@@ -110,13 +117,22 @@ void computeStressRatiosForBeams(const Model& m, const Materials& mat, const Vec
 /// Scratch, not part of State: a fresh schedule computes every element once, so a restarted run deletes the same
 /// elements as the run it continues.
 inline constexpr double kStressScheduleMargin = 1e-4;
+inline constexpr int kStressCheckChunk = 64;
 struct StressCheckSchedule {
   long step = -1;          // the step of the last check (-1: none); a check at any other step than the next starts afresh
   double drift = 0;        // bound on how far any DOF moved since the schedule started
   std::vector<double> pairDrift;  // per slice k: bound on how far any DOF of slices k and k + 1 moved since then
   std::vector<int> pairOf; // per rod element: the k of its slices k, k + 1 (-1: it follows `drift`)
   std::vector<double> due; // per rod element: its drift from which its stress must be computed again
+  // Chunks of kStressCheckChunk consecutive elements (elements are in the order of their first node, so a chunk
+  // spans one or two pairs of slices): a chunk whose smallest due is above the largest drift of its elements is
+  // skipped whole, without reading its elements.
+  std::vector<double> chunkDue;      // per chunk: the smallest due of its intact elements (when last visited)
+  std::vector<int> chunkPairs;       // per chunk: the first and last pair its elements follow (2 entries; first >
+                                     // last: none)
+  std::vector<std::uint8_t> chunkFollowsDrift;  // per chunk: some element follows `drift`
   long computed = 0;       // elements computed at the last check
+  long visitedChunks = 0;  // chunks read at the last check
   double largestRatio = 0; // the largest ratio computed at the last check: an element at 1 - kStressScheduleMargin
                            // or above is computed at every check, so no ratio reaches 1 while this stays below
 };

@@ -23,10 +23,11 @@ using namespace enamel;
 
 namespace {
 
-CaseParams smallCase(const std::string& extra) {
+// 8 d wide, `height` d high (4: one chunk of interfaces per slice, InterfaceSchedule; 16: two or more).
+CaseParams smallCase(const std::string& extra, int height = 4) {
   // E_transverse given (not measured) to keep the set-up short.
   return parseCase("theta_D = 30\nEr_over_kd = 10\nsigma_ru_over_sigma0 = 21.4\nE_transverse_over_Er = 0.1\n"
-                   "w_s_over_d = 8\nh_s_over_d = 4\n" + extra,
+                   "w_s_over_d = 8\nh_s_over_d = " + std::to_string(height) + "\n" + extra,
                    "kernels", "", {});
 }
 
@@ -44,13 +45,13 @@ VecX pseudoRandomField(int n, double amp) {
 // f_iface as the lumped step applies it: K_I q (elasticInterfaceBlocks, in its node rows) less, per slice, the
 // wrench W of its interfaces beyond their elastic force (addInterfaceCorrectionsOfSliceScheduled, the call the
 // step makes per slice; nothing where it wrote none), the slices in parallel. schedule.evaluated: the interfaces
-// the law saw. Returns the number of failed interfaces.
+// the law saw; schedule.visitedChunks: the chunks of interfaces read. Returns the number of failed interfaces.
 int scheduledInterfaceForces(const Model& m, const cohesive::Law& law, const Operators& ops, const NodeBlockMatrix& KI,
                              const VecX& q, std::vector<double>& lambdaMax, InterfaceSchedule& schedule, VecX& f) {
   f.resize(m.numDofs());
   int failed = 0;
-  long evaluated = 0;
-#pragma omp parallel reduction(+ : failed, evaluated)
+  long evaluated = 0, chunks = 0;
+#pragma omp parallel reduction(+ : failed, evaluated, chunks)
   {
     std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
 #pragma omp for schedule(static)
@@ -58,6 +59,7 @@ int scheduledInterfaceForces(const Model& m, const cohesive::Law& law, const Ope
       const SliceCorrections pass = addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q.data(), lambdaMax.data(),
                                                                             schedule, wrench.data(), evaluated);
       failed += pass.failed;
+      chunks += pass.chunks;
       for (int node = ops.sliceNodeStart[k]; node < ops.sliceNodeStart[k + 1]; ++node) {
         Vec6 elastic;
         multiplyBlockRowSplit<kInterfaceGroups>(KI, node, q.data(), elastic);
@@ -67,6 +69,7 @@ int scheduledInterfaceForces(const Model& m, const cohesive::Law& law, const Ope
     }
   }
   schedule.evaluated = evaluated;
+  schedule.visitedChunks = chunks;
   return failed;
 }
 
@@ -139,8 +142,8 @@ TEST(Kernels, InterfaceGatherSumsComputeInterfaceForces) {
 // most steps compute only a few elements; a step that moved further than the scheme says would be unsafe, so a
 // jump (q replaced) must be given as an infinite move, and then every element is computed. `perSlice`: each
 // slice's own move is given (each element follows its pair of slices), otherwise only the largest.
-static void checkScheduledStressCheckFindsWhatTheFullCheckFinds(bool perSlice, long& computed) {
-  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+static void checkScheduledStressCheckFindsWhatTheFullCheckFinds(bool perSlice, long& computed, int height = 4) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n", height));
   const Model& m = sim.model;
   const Materials& mat = sim.materials;
   const std::vector<std::uint8_t> broken(m.numBeams(), 0);
@@ -203,13 +206,15 @@ TEST(Kernels, ScheduledStressCheckFindsWhatTheFullCheckFinds) {
   checkScheduledStressCheckFindsWhatTheFullCheckFinds(false, global);
   checkScheduledStressCheckFindsWhatTheFullCheckFinds(true, perSlice);
   EXPECT_LT(perSlice, global) << "slices that move less are computed less often";
+  checkScheduledStressCheckFindsWhatTheFullCheckFinds(true, perSlice, 16);  // more chunks of elements per pair
 }
 
 // Each element follows the drift of its own two slices: when only the nodes of one slice move, only the elements
-// that reach that slice are ever computed (after the fresh start), however far it moves; given only the largest
-// move, elements everywhere come due.
+// that reach that slice are ever computed (after the fresh start), however far it moves, and only the chunks of
+// elements (StressCheckSchedule::chunkDue) that hold one of them are read; given only the largest move, elements
+// everywhere come due.
 TEST(Kernels, ScheduledStressCheckFollowsEachSlicesMove) {
-  Simulation sim(smallCase("integrator = \"lumped\"\n"));
+  Simulation sim(smallCase("integrator = \"lumped\"\n", 16));
   const Model& m = sim.model;
   const Materials& mat = sim.materials;
   const std::vector<std::uint8_t> broken(m.numBeams(), 0);
@@ -221,6 +226,18 @@ TEST(Kernels, ScheduledStressCheckFollowsEachSlicesMove) {
   VecX wobble = VecX::Zero(m.numDofs());
   for (int node = sim.ops.sliceNodeStart[moving]; node < sim.ops.sliceNodeStart[moving + 1]; ++node)
     wobble.segment<6>(6 * node) = shape.segment<6>(6 * node);
+  auto reachesMoving = [&](int e) {
+    return m.nodeSlice[m.beamNodes[e][0]] == moving || m.nodeSlice[m.beamNodes[e][1]] == moving;
+  };
+  const int chunks = (m.numBeams() + kStressCheckChunk - 1) / kStressCheckChunk;
+  int chunksReaching = 0;
+  for (int c = 0; c < chunks; ++c) {
+    bool reaches = false;
+    for (int e = c * kStressCheckChunk; e < std::min(m.numBeams(), (c + 1) * kStressCheckChunk); ++e)
+      reaches = reaches || reachesMoving(e);
+    chunksReaching += reaches;
+  }
+  ASSERT_LT(chunksReaching, chunks / 4);
   for (bool perSlice : {true, false}) {
     StressCheckSchedule schedule;
     std::vector<double> ratio;
@@ -232,15 +249,13 @@ TEST(Kernels, ScheduledStressCheckFollowsEachSlicesMove) {
       std::fill(ratio.begin(), ratio.end(), -1.0);  // an element the check computes gets its ratio, >= 0
       checkStressRatiosForBeams(m, mat, q, broken, n, (q - qPrev).cwiseAbs().maxCoeff() * (1 + 1e-12) + 1e-300,
                                 perSlice ? movesOfSlices(m, q - qPrev) : std::vector<double>{}, schedule, ratio);
+      if (perSlice) ASSERT_LE(schedule.visitedChunks, chunksReaching) << "step " << n;
       for (int e = 0; e < m.numBeams(); ++e) everComputed[e] |= ratio[e] >= 0;
       qPrev = q;
     }
     int reaching = 0, elsewhere = 0;
-    for (int e = 0; e < m.numBeams(); ++e) {
-      if (!everComputed[e]) continue;
-      const int a = m.nodeSlice[m.beamNodes[e][0]], b = m.nodeSlice[m.beamNodes[e][1]];
-      (a == moving || b == moving ? reaching : elsewhere) += 1;
-    }
+    for (int e = 0; e < m.numBeams(); ++e)
+      if (everComputed[e]) (reachesMoving(e) ? reaching : elsewhere) += 1;
     EXPECT_GT(reaching, 0) << (perSlice ? "per slice" : "largest move only");
     if (perSlice)
       EXPECT_EQ(elsewhere, 0) << "an element away from the moving slice was computed";
@@ -279,8 +294,9 @@ TEST(Kernels, ElasticInterfaceForceIsTheLawsOnTheElasticBranch) {
 // `keys`: further case keys (the mixed-mode law's shear_strength_ratio, whose lambda weighs shear by 1/beta^2).
 // The slices move at different speeds; `perSlice`: each slice's own move is given, otherwise only the largest.
 // `evaluated`: the interfaces the law saw, over the path.
-static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys, bool perSlice, long& evaluated) {
-  Simulation sim(smallCase("integrator = \"lumped\"\n" + keys));
+static void checkScheduledInterfacePassFollowsTheLaw(const std::string& keys, bool perSlice, long& evaluated,
+                                                     int height = 4) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n" + keys, height));
   const Model& m = sim.model;
   const cohesive::Law& law = sim.materials.law;
   const int n = m.numDofs();
@@ -339,6 +355,44 @@ static void checkScheduledInterfacePassBothWays(const std::string& keys) {
 }
 
 TEST(Kernels, ScheduledInterfacePassFollowsTheLaw) { checkScheduledInterfacePassBothWays(""); }
+// Slices of several chunks of interfaces (InterfaceSchedule::chunkDue), some skipped and some read.
+TEST(Kernels, ScheduledInterfacePassFollowsTheLawInChunks) {
+  long global = 0, perSlice = 0;
+  checkScheduledInterfacePassFollowsTheLaw("", false, global, 16);
+  checkScheduledInterfacePassFollowsTheLaw("", true, perSlice, 16);
+  EXPECT_LT(perSlice, global);
+}
+
+// A pass reads only the chunks of interfaces that hold a due one: at rest after a fresh pass (all read) none is
+// due and none is read; with one interface due (its due, and so its chunk's and slice's smallest, at the drift)
+// the law sees it alone and its chunk is the only one read, though its slice has several.
+TEST(Kernels, ScheduledInterfacePassReadsOnlyChunksWithADueInterface) {
+  Simulation sim(smallCase("integrator = \"lumped\"\n", 16));
+  const Model& m = sim.model;
+  const cohesive::Law& law = sim.materials.law;
+  const NodeBlockMatrix KI = elasticInterfaceBlocks(m, law, sim.ops);
+  const VecX q = VecX::Zero(m.numDofs());
+  std::vector<double> lambdaMax(m.numInterfaces(), 0.0);
+  InterfaceSchedule schedule;
+  VecX f;
+  advanceInterfaceSchedule(m, law, sim.ops, INFINITY, {}, 0.0, schedule);
+  scheduledInterfaceForces(m, law, sim.ops, KI, q, lambdaMax, schedule, f);
+  EXPECT_EQ(schedule.evaluated, m.numInterfaces());
+  EXPECT_EQ(schedule.visitedChunks, schedule.sliceChunkStart[m.numSlices]);
+  advanceInterfaceSchedule(m, law, sim.ops, 0.0, {}, 0.0, schedule);
+  scheduledInterfaceForces(m, law, sim.ops, KI, q, lambdaMax, schedule, f);
+  EXPECT_EQ(schedule.evaluated, 0);
+  EXPECT_EQ(schedule.visitedChunks, 0);
+  const int k = m.numSlices / 2, c = schedule.sliceChunkStart[k] + 1;
+  ASSERT_GE(schedule.sliceChunkStart[k + 1] - schedule.sliceChunkStart[k], 2) << "a slice of several chunks";
+  const int i = sim.ops.sliceIfaceStart[k] + kInterfaceChunk + 3;  // in the slice's second chunk
+  schedule.due[i] = schedule.chunkDue[c] = schedule.sliceDue[k] = schedule.drift[k];
+  advanceInterfaceSchedule(m, law, sim.ops, 0.0, {}, 0.0, schedule);
+  scheduledInterfaceForces(m, law, sim.ops, KI, q, lambdaMax, schedule, f);
+  EXPECT_EQ(schedule.evaluated, 1);
+  EXPECT_EQ(schedule.visitedChunks, 1);
+  EXPECT_GT(schedule.chunkDue[c], schedule.drift[k]) << "evaluated, it is not due again at once";
+}
 // A weak shear (beta < 1) makes lambda grow faster than the opening's norm: the schedule must bound that.
 TEST(Kernels, ScheduledInterfacePassFollowsTheMixedModeLawWeakShear) {
   checkScheduledInterfacePassBothWays("shear_strength_ratio = 0.5\n");

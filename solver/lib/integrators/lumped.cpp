@@ -262,8 +262,8 @@ class LumpedIntegrator : public Integrator {
     const double* v = s.vHalf.data();
     double* lambda = s.lambdaMax.data();
     int failed = 0;
-    long evaluated = 0;
-#pragma omp parallel reduction(+ : failed, evaluated) firstprivate(law, q, v, lambda, step)
+    long evaluated = 0, chunks = 0;
+#pragma omp parallel reduction(+ : failed, evaluated, chunks) firstprivate(law, q, v, lambda, step)
     {
       std::vector<double> wrench(6 * static_cast<std::size_t>(ops.maxNodesPerSlice));
       std::vector<DoublePair> KIq(3 * static_cast<std::size_t>(ops.maxNodesPerSlice));  // the slice's K_I q_n
@@ -274,6 +274,7 @@ class LumpedIntegrator : public Integrator {
         const SliceCorrections pass =
             addInterfaceCorrectionsOfSliceScheduled(m, law, ops, k, q, lambda, ifaceSchedule_, wrench.data(), evaluated);
         failed += pass.failed;
+        chunks += pass.chunks;
         laps.lap(StepPhase::SliceInterfaces);
         const SliceOutputs::Slot to = out.slotOf(k);
         // no wrench written: every node reads the same six zeros
@@ -290,6 +291,7 @@ class LumpedIntegrator : public Integrator {
       if (timers_) bookShareOfThread(mine);
     }
     ifaceSchedule_.evaluated = evaluated;
+    ifaceSchedule_.visitedChunks = chunks;
     return failed;
   }
 
