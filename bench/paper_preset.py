@@ -268,6 +268,8 @@ def report(against: pathlib.Path = AGAINST) -> int:
     L += ["", "R_ss is the mean R over the last 20% of the crack advance reached and R_m the mean over "
           "0 < Delta_a/d < 30 (README, \"Solver\"), so the two sizes average different ranges.", ""]
     title = f"enamel-dem, one {PRESET}-preset case ({VARIANT}), {date}"
+    if EXTRA_SETS:  # a variant's overrides, on a line of their own
+        title += "\n" + ", ".join(f"{k}={v}" for k, v in EXTRA_SETS.items())
     figure(r, reduced, title)
     md = OUT / "paper_preset.md"
     md.write_text("\n".join(L))
