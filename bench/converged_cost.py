@@ -12,7 +12,8 @@ roles of solver:
   so its R-curve differs at equal numerics), so the R-curve is judged against today's model at the preset's
   numerics, and the baseline's R-curve is reported beside it. When the reference's command is the new one's
   (no --set and no --reference-set), the new run is its own reference and is not run twice.
-One thread a run, --jobs runs at once, the baseline's runs first.
+One thread a run, --jobs runs at once: case by case the baseline's run and the new one (so that at two jobs the
+runs of a ratio run at the same time or close to it), then the reference's.
 
 Per run: core-seconds (the solver process's own CPU time, user + system, from os.wait4, summed over the pieces
 of a resumed run), wall seconds, steps and DOF (the result file's /meta), the machine (CPU model), the start of
@@ -131,17 +132,25 @@ def solver_args(v: Variant, case: str, preset: str, out: pathlib.Path, checkpoin
 # ---------------------------------------------------------------------------------------------------- runs
 def run_all(variants: list[Variant], cases, preset: str, runs: pathlib.Path, jobs: int, nice: int,
             checkpoint_every: float) -> None:
-    """Every case by every variant, `jobs` at once, the baseline's first; Ctrl-C / SIGTERM: every running solver
+    """Every case by every variant, `jobs` at once, in run_order's order; Ctrl-C / SIGTERM: every running solver
     writes its checkpoint and stops, its piece is recorded, and nothing more starts (bench.jobs.run_resumable)."""
     todo = []
-    for v in (v for v in variants if v.same_as is None):
-        for case in cases:
-            out = runs / preset / v.label / case
-            cmd = solver_args(v, case, preset, out, checkpoint_every)
-            wrapped = (["nice", "-n", str(nice)] if nice else []) + cmd   # nice execs: wait4 sees the solver
-            todo.append((bench_jobs.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
-                                        expected_s=2.0 if v.role != "new" else 1.0), cmd))
+    order = run_order([v for v in variants if v.same_as is None], cases)
+    for rank, (v, case) in enumerate(order):
+        out = runs / preset / v.label / case
+        cmd = solver_args(v, case, preset, out, checkpoint_every)
+        wrapped = (["nice", "-n", str(nice)] if nice else []) + cmd   # nice execs: wait4 sees the solver
+        todo.append((bench_jobs.Job(case=case, variant=v.label, args=wrapped, cores=1, out=out,
+                                    expected_s=float(len(order) - rank)), cmd))  # run_jobs starts the largest first
     bench_jobs.run_resumable(todo, jobs)
+
+
+def run_order(variants: list[Variant], cases) -> list[tuple[Variant, str]]:
+    """Case by case the baseline's run and then the new one, so that at two jobs the runs whose core-seconds make a
+    ratio run at the same time or close to it (a machine whose speed drifts during the bench moves both); the
+    reference's runs (the R-curve's, not the cost's) after them."""
+    cost = [(v, c) for c in cases for v in variants if v.role != "reference"]
+    return cost + [(v, c) for c in cases for v in variants if v.role == "reference"]
 
 
 # ---------------------------------------------------------------------------------------------------- rows

@@ -106,6 +106,16 @@ def test_stopped_continued_and_tabled(enamel, tmp_path):
     assert "--set dt_factor=0.15" in md and "Reference: solver" in md
 
 
+def test_run_order_pairs_each_cases_baseline_and_new(tmp_path, enamel):
+    """Case by case the baseline and then the new run (the two runs of a ratio side by side at two jobs), the
+    reference's runs last."""
+    variants = [v for v in converged_cost.variants_of(enamel, enamel, [], ["dt_factor=0.15"], [])
+                if v.same_as is None]
+    order = [(v.role, case) for v, case in converged_cost.run_order(variants, ["a", "b", "c"])]
+    assert order == [("baseline", "a"), ("new", "a"), ("baseline", "b"), ("new", "b"), ("baseline", "c"),
+                     ("new", "c"), ("reference", "a"), ("reference", "b"), ("reference", "c")]
+
+
 @pytest.mark.parametrize("ratio, same, met", [(3.0, True, True), (7.5, True, True), (2.9, True, False),
                                               (5.0, False, False), (2.0, False, False), (math.nan, None, False)])
 def test_verdict(ratio, same, met):
