@@ -162,7 +162,6 @@ void advanceInterfaceSchedule(const Model& m, const cohesive::Law& law, const Op
   if (!std::isfinite(moved) || static_cast<int>(schedule.due.size()) != m.numInterfaces()) {
     schedule.drift.assign(m.numSlices, 0.0);
     schedule.due.assign(m.numInterfaces(), 0.0);
-    schedule.sliceDue.assign(m.numSlices, 0.0);
     schedule.sliceChunkStart.assign(m.numSlices + 1, 0);
     for (int k = 0; k < m.numSlices; ++k) {
       const int interfaces = ops.sliceIfaceStart[k + 1] - ops.sliceIfaceStart[k];
@@ -217,23 +216,20 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
     InterfaceSchedule& schedule, double* wrench, long& evaluated) {
   const double drift = schedule.drift[k], dueBelow = schedule.allDue ? INFINITY : drift;
   SliceCorrections pass;
-  if (schedule.sliceDue[k] > dueBelow) return pass;  // none due: all elastic, their forces in K_I q
   const cohesive::Law law = lawGiven;  // a local copy, as in addInterfaceWrenchesOfSlice
   const int first = ops.sliceIfaceStart[k], last = ops.sliceIfaceStart[k + 1], firstNode = ops.sliceNodeStart[k];
-  std::fill(wrench, wrench + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
-  pass.wrench = true;
   const auto* nodes = m.ifaceNodes.data();
   const cohesive::SliceInterface* packed = ops.ifacePacked.data();
   double* due = schedule.due.data();
   double* chunkDue = schedule.chunkDue.data();
-  double sliceDue = INFINITY;
   for (int c = schedule.sliceChunkStart[k], i = first; c < schedule.sliceChunkStart[k + 1]; ++c) {
     const int end = std::min(last, i + kInterfaceChunk);
-    if (chunkDue[c] > dueBelow) {  // none due: all elastic
-      sliceDue = std::min(sliceDue, chunkDue[c]);
+    if (chunkDue[c] > dueBelow) {  // none due: all elastic, their forces in K_I q
       i = end;
       continue;
     }
+    if (!pass.wrench) std::fill(wrench, wrench + 6 * (ops.sliceNodeStart[k + 1] - firstNode), 0.0);
+    pass.wrench = true;
     ++pass.chunks;
     double smallest = INFINITY;
     for (; i < end; ++i) {
@@ -247,9 +243,7 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
       smallest = std::min(smallest, due[i]);
     }
     chunkDue[c] = smallest;
-    sliceDue = std::min(sliceDue, smallest);
   }
-  schedule.sliceDue[k] = sliceDue;
   return pass;
 }
 

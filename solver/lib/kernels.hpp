@@ -62,9 +62,8 @@ struct InterfaceSchedule {
   bool allDue = false;        // this pass evaluates every interface (otherwise those with due <= their slice's drift)
   double largestRate = 0;     // max over interfaces of c
   std::vector<double> due;    // per interface: the drift from which the law must see it again
-  std::vector<double> sliceDue;  // per slice: the smallest due of its interfaces (a slice with none due is skipped)
   // Each slice's interfaces in chunks of kInterfaceChunk consecutive ones (the last of a slice may be shorter): a
-  // chunk with none due is skipped whole, without reading its interfaces.
+  // chunk with none due is skipped whole, without reading its interfaces, and a slice with none due is not visited.
   std::vector<int> sliceChunkStart;  // per slice k: its first chunk (sliceChunkStart[numSlices]: the number of chunks)
   std::vector<double> chunkDue;      // per chunk: the smallest due of its interfaces
   long visitedChunks = 0;            // chunks the last pass read (the sum of SliceCorrections::chunks)
@@ -89,8 +88,8 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
 /// as K_I q (elasticInterfaceBlocks) in its node rows: into wrench, per node of slice k, what the law adds to
 /// that, the wrench of (law's force - elastic force) of each interface off the elastic branch. An interface
 /// not due adds nothing (it is elastic); a due one is evaluated by the law (lambdaMax updated), adds its
-/// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. A slice
-/// none of whose interfaces is due (schedule.sliceDue) is not visited, and its wrench not written. Adds the
+/// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. A chunk
+/// none of whose interfaces is due (schedule.chunkDue) is not read; a slice with no chunk read gets no wrench written. Adds the
 /// interfaces evaluated to `evaluated`.
 struct SliceCorrections {
   int failed = 0;       // failed interfaces of the slice

@@ -364,7 +364,7 @@ TEST(Kernels, ScheduledInterfacePassFollowsTheLawInChunks) {
 }
 
 // A pass reads only the chunks of interfaces that hold a due one: at rest after a fresh pass (all read) none is
-// due and none is read; with one interface due (its due, and so its chunk's and slice's smallest, at the drift)
+// due and none is read; with one interface due (its due, and so its chunk's smallest, at the drift)
 // the law sees it alone and its chunk is the only one read, though its slice has several.
 TEST(Kernels, ScheduledInterfacePassReadsOnlyChunksWithADueInterface) {
   Simulation sim(smallCase("integrator = \"lumped\"\n", 16));
@@ -386,7 +386,7 @@ TEST(Kernels, ScheduledInterfacePassReadsOnlyChunksWithADueInterface) {
   const int k = m.numSlices / 2, c = schedule.sliceChunkStart[k] + 1;
   ASSERT_GE(schedule.sliceChunkStart[k + 1] - schedule.sliceChunkStart[k], 2) << "a slice of several chunks";
   const int i = sim.ops.sliceIfaceStart[k] + kInterfaceChunk + 3;  // in the slice's second chunk
-  schedule.due[i] = schedule.chunkDue[c] = schedule.sliceDue[k] = schedule.drift[k];
+  schedule.due[i] = schedule.chunkDue[c] = schedule.drift[k];
   advanceInterfaceSchedule(m, law, sim.ops, 0.0, {}, 0.0, schedule);
   scheduledInterfaceForces(m, law, sim.ops, KI, q, lambdaMax, schedule, f);
   EXPECT_EQ(schedule.evaluated, 1);
