@@ -9,7 +9,8 @@ tests and the pipeline run (ENAMEL_BINARY, else build/enamel-dem: enamel_results
     RESULT_SEAL   the result file's seal in its HDF5 user block: magic, format, userblock_bytes, bytes, fields
                   (name, struct code, offset) in order (output.hpp ResultSeal)
     RESULT_FILES  {run status: its result file's name} (output.hpp resultFileName)
-    LOADING_RATE  the adaptive loading rate's rule: rho_high, rho_low, raise, lower (loading_rate.hpp)
+    LOADING_RATE  the adaptive loading rate's rule: rho_high, rho_low (the defaults of case key rate_adapt_rho_high
+                  and of a quarter of it), rho_low_share, raise, lower (loading_rate.hpp)
     KEY_CHOICES   {case key: its allowed values in order} (choices.hpp)
 
 Each name is read when first used, so importing this module needs no solver; without one (or with one too old to

@@ -61,6 +61,10 @@ STUDY3 = {"margin8_h20_qs": margin(8, 20), "margin16_h20_qs": margin(16, 20)}   
 # README.md, Study 4: the converged check at the default model (G = 9, cut tip); its reference is the converged
 # set's own record of the case (records/converged/CASE.json: the same keys at phi = 1, the same build)
 STUDY4 = {"s4_margin8_h20_qs": margin(8, 20), "s4_margin4_h10_qs": margin(4, 10)}
+# README.md, Study 5: study 4's choice with the energy part's bounds raised (rate_adapt_rho_high), at converged,
+# against the same references; run order rho 0.04 (both cases), then rho 0.02
+STUDY5 = {f"s5_margin4_h10_qs_rho{tag}": {**margin(4, 10), "rate_adapt_rho_high": rho}
+          for tag, rho in (("04", 0.04), ("02", 0.02))}
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
@@ -69,6 +73,7 @@ STUDY1 = tuple(CANDIDATES)
 CANDIDATES.update(STUDY2)
 CANDIDATES.update(STUDY3)
 CANDIDATES.update(STUDY4)
+CANDIDATES.update(STUDY5)
 CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
 # reduced starts as converged does (its preset's own 0.95); the ci smoke run as its preset
 STATIC_START = {"reduced": 0.95, "converged": 0.95, "ci": 0.0}
@@ -294,13 +299,13 @@ def converged_reference(case: str) -> dict:
                 R=list(map(float, r.R)), broken_rods=int(r.broken_rods), core_seconds=float(r.meta["wall_time_s"]))
 
 
-def rows4() -> list[dict]:
-    """Study 4's candidates against the converged set's records (judged_row; eligible (same) only with S3 too; core
-    seconds against the record's wall seconds, indicative only: not run side by side)."""
+def rows4(names=tuple(STUDY4)) -> list[dict]:
+    """Study 4's (or 5's) candidates against the converged set's records (judged_row; eligible (same) only with S3
+    too; core seconds against the record's wall seconds, indicative only: not run side by side)."""
     out = []
     for case in CASES:
         ref = converged_reference(case)
-        for name in STUDY4:
+        for name in names:
             own = DATA / f"converged__{case}__{name}.json"
             if not own.exists():
                 continue
@@ -315,6 +320,27 @@ def report4() -> str:
     rws = rows4()
     return "\n".join(judged_table(rws, core_ratio=True)) + "\n\nDecision: " + \
         decision(rws).replace("goes to the converged check", "is bench-converged's CONVERGED_SET") + "\n"
+
+
+STUDY4_CHOICE = "s4_margin4_h10_qs"
+
+
+def decision5(rws: list[dict]) -> str:
+    """README.md, Study 5, Decision: the eligible candidate with the largest smaller-of-two (S1), if above study 4's
+    choice's; else study 4's choice stays."""
+    s4 = best([w for w in rws if w["candidate"] == STUDY4_CHOICE])
+    above = s4[1] if s4 else 0.0
+    b = best([w for w in rws if w["candidate"] != STUDY4_CHOICE], above)
+    if b:
+        return (f"{b[0]} replaces {STUDY4_CHOICE} as bench-converged's CONVERGED_SET (S1 {b[1]:.2f} against "
+                f"{above:.2f}, the smaller of the two cases)")
+    return f"none is eligible with (S1) above {STUDY4_CHOICE}'s {above:.2f}: it stays bench-converged's CONVERGED_SET"
+
+
+def report5() -> str:
+    """Study 5's table (study 4's choice beside its candidates) and its decision."""
+    rws = rows4((STUDY4_CHOICE, *STUDY5))
+    return "\n".join(judged_table(rws, core_ratio=True)) + "\n\nDecision: " + decision5(rws) + "\n"
 
 
 def report() -> str:
@@ -350,11 +376,11 @@ def main(argv=None) -> int:
     chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
     chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     for p in (every, rep):
-        p.add_argument("--study", type=int, choices=(1, 2, 3, 4), default=1)
+        p.add_argument("--study", type=int, choices=(1, 2, 3, 4, 5), default=1)
     a = ap.parse_args(argv)
     if a.cmd == "report":
-        print(report() if a.study == 1 else report4() if a.study == 4 else report2(names=STUDY_NAMES[a.study]),
-              end="")
+        print(report() if a.study == 1 else report4() if a.study == 4 else report5() if a.study == 5 else
+              report2(names=STUDY_NAMES[a.study]), end="")
         return 0
     if a.cmd == "check":
         return 0 if check(a.binary)["reuse_study1"] else 1
@@ -362,8 +388,8 @@ def main(argv=None) -> int:
         return run_one(a.binary, a.preset, a.case, a.candidate)
     if a.study in STUDY_NAMES:
         return all2(a.binary, a.preset, STUDY_NAMES[a.study])
-    if a.study == 4:   # README.md, Study 4's order: margin8_h20_qs on both cases, then margin4_h10_qs
-        for name in STUDY4:
+    if a.study in (4, 5):   # README.md, Study 4's (5's) order: each candidate on both cases, in the table's order
+        for name in (STUDY4 if a.study == 4 else STUDY5):
             for case in CASES:
                 rc = run_one(a.binary, "converged", case, name)
                 if rc != 0:

@@ -49,3 +49,18 @@ def test_study2_decision_takes_the_largest_smaller_saving_of_those_same_on_both_
     tie = rows("margin8_h40_qs", (1.8, 2.2), (True, True)) + rows("margin4_h40_qs", (1.8, 1.9), (True, True))
     assert rate.decision(tie).startswith("margin4_h40_qs goes")       # the same 1.8: the smaller phi_max
     assert rate.decision(rows("margin8_h10_qs", (3.0, 2.5), (True, False))).startswith("none meets")
+
+
+def test_study5_replaces_study4s_choice_only_when_eligible_and_saving_more():
+    """README.md, Study 5, Decision: a candidate replaces study 4's choice only when it is the same on both cases and
+    its smaller-of-two steps ratio is above the choice's."""
+    def rows(name, ratios, same):
+        return [dict(candidate=name, case=c, steps_ratio=r, same=s) for c, r, s in zip(rate.CASES, ratios, same)]
+    s4 = rows(rate.STUDY4_CHOICE, (1.74, 1.71), (True, True))
+    rho04, rho02 = rate.STUDY5
+    assert rate.decision5(s4 + rows(rho04, (2.6, 2.2), (True, True)) + rows(rho02, (2.0, 1.9), (True, True))) \
+        .startswith(f"{rho04} replaces")
+    assert rate.decision5(s4 + rows(rho04, (2.6, 2.2), (True, False)) + rows(rho02, (2.0, 1.9), (True, True))) \
+        .startswith(f"{rho02} replaces")                                 # rho 0.04 not the same on theta15
+    assert rate.decision5(s4 + rows(rho04, (2.6, 1.6), (True, True))).startswith("none is eligible")   # 1.6 < 1.71
+    assert rate.CANDIDATES[rho04]["rate_adapt_rho_high"] == 0.04

@@ -132,7 +132,8 @@ enum class Need { required, optional };
       "adaptive loading rate: the largest multiplier phi it may apply on top of v_app (1 = off); at each "         \
       "history row, with rho = kinetic energy beyond the quasi-static motion of proportional loading (history "  \
       "column kinetic_energy_beyond_loading) / strain energy (rods + interfaces), phi is halved (not below 1) when a "    \
-      "rod element was deleted in the interval or rho > 0.01, x1.25 (not above this) when rho < 0.0025 and no rod " \
+      "rod element was deleted in the interval or rho > rate_adapt_rho_high (0.01), x1.25 (not above this) when "  \
+      "rho < a quarter of it (0.0025) and no rod "                                                                 \
       "element was deleted and no more interfaces failed than 4 x the pre-cracked interfaces of one slice, else "   \
       "held; phi "                                                                                                  \
       "ramps linearly to its new value over the next history interval")                                            \
@@ -146,6 +147,10 @@ enum class Need { required, optional };
     X(rate_adapt_horizon, Real, numerics, optional, 10, "[]", 1, 1e4, "history rows at phi = 1",                   \
       "adaptive loading rate, margin rule: phi is the forecast rows to the next failure event / this (within "    \
       "[1, rate_adapt_max]), so the rate falls to 1 as the event comes within this many rows of loading at v_app") \
+    X(rate_adapt_rho_high, Real, numerics, optional, 0.01, "(]", 0, 0.05, "-",                                     \
+      "adaptive loading rate (either rule): the bound on rho = kinetic energy beyond the loading's motion / "      \
+      "strain energy above which phi is halved; phi rises only while rho is below a quarter of it; at most the "  \
+      "quasi-static warning bound 0.05 (docs/solver.md, Adaptive loading rate)")                                  \
     X(rate_adapt_velocity, Choice, numerics, optional, RateAdaptVelocity::keep, "[]", 0, 0, "-",                   \
       "adaptive loading rate's velocity at a change of phi: keep = the free nodes keep their velocity (the "       \
       "interior follows the grips' new rate by waves); quasi_static = each time step over which phi changes adds " \

@@ -7,15 +7,16 @@
 
 namespace enamel {
 
-// rho = kinetic / strain; lower on a deletion or rho > rho_hi, raise when rho < rho_lo and quiet, else hold.
+// rho = kinetic / strain; lower on a deletion or rho > rho_hi, raise when rho < rho_lo and quiet, else hold
+// (rho_lo = kRateRhoLowShare rho_hi: a power of two, so the default's rho_lo is kRateRhoLow exactly).
 double nextRateMultiplier(double phi, double phiMax, const RateControlInput& in) {
   const bool deleted = in.rodsDeleted > 0;
   const bool burst = in.interfacesFailed > in.burstInterfaces;
   if (deleted) return std::max(1.0, kRateLower * phi);
   if (!(in.strain > 0)) return phi;  // no rho yet
   const double rho = in.kinetic / in.strain;
-  if (rho > kRateRhoHigh) return std::max(1.0, kRateLower * phi);
-  if (rho < kRateRhoLow && !burst) return std::min(phiMax, kRateRaise * phi);
+  if (rho > in.rhoHigh) return std::max(1.0, kRateLower * phi);
+  if (rho < kRateRhoLowShare * in.rhoHigh && !burst) return std::min(phiMax, kRateRaise * phi);
   return phi;
 }
 

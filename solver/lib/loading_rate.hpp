@@ -26,8 +26,10 @@
 namespace enamel {
 
 // The rule's bounds (the quasi-static warning bound, runner.hpp kKineticWarn, is 0.05).
-constexpr double kRateRhoHigh = 0.01;     // rho = kinetic / strain above this: halve phi
-constexpr double kRateRhoLow = 0.0025;    // rho below this (and nothing broke): raise phi
+constexpr double kRateRhoHigh = 0.01;     // rho = kinetic / strain above this: halve phi (the default of the
+                                          // case key rate_adapt_rho_high)
+constexpr double kRateRhoLowShare = 0.25; // rho below this share of the high bound (and nothing broke): raise phi
+constexpr double kRateRhoLow = kRateRhoLowShare * kRateRhoHigh;  // 0.0025 at the default
 constexpr double kRateRaise = 1.25;       // raise: phi x 1.25 (not above rate_adapt_max)
 constexpr double kRateLower = 0.5;        // lower: phi x 0.5 (not below 1)
 constexpr int kRateBurstSlices = 4;       // a burst: more interfaces failed in the interval than this many
@@ -41,11 +43,14 @@ struct RateControlInput {
   int interfacesFailed = 0; // interfaces that failed during the interval
   int burstInterfaces = 0;  // more failures than this in one interval are a burst
   double rowsToEvent = NAN; // the margin rule's forecast (EventForecast::rows); NaN: none (the energy rule)
+  double rhoHigh = kRateRhoHigh;  // the high bound on rho (case key rate_adapt_rho_high); the low one is
+                                  // kRateRhoLowShare x this
 };
 
-/// The rule (pure): with rho = kinetic / strain,
-///   lower (phi / 2, not below 1)            when a rod element was deleted or rho > kRateRhoHigh;
-///   raise (phi x 1.25, not above phiMax)    when rho < kRateRhoLow, no rod element was deleted and no more
+/// The rule (pure): with rho = kinetic / strain, rho_hi = in.rhoHigh (kRateRhoHigh unless the case sets
+/// rate_adapt_rho_high) and rho_lo = kRateRhoLowShare x rho_hi,
+///   lower (phi / 2, not below 1)            when a rod element was deleted or rho > rho_hi;
+///   raise (phi x 1.25, not above phiMax)    when rho < rho_lo, no rod element was deleted and no more
 ///                                           than burstInterfaces interfaces failed;
 ///   hold otherwise (also while there is no strain energy yet and nothing was deleted: rho is undefined).
 /// The result is always within [1, max(phi, phiMax)].

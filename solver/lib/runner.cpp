@@ -402,6 +402,7 @@ class RunLoop {
     in.interfacesFailed = now.failedInterfaces - before.failedInterfaces;
     in.burstInterfaces = burstInterfaces_;
     in.rowsToEvent = rowsToEvent;
+    in.rhoHigh = p_.rate_adapt_rho_high;
     State& s = sim_.state;
     const double phi = margin ? nextRateMultiplierByMargin(s.rateMultiplier, p_.rate_adapt_max, p_.rate_adapt_horizon, in)
                               : nextRateMultiplier(s.rateMultiplier, p_.rate_adapt_max, in);

@@ -2,6 +2,7 @@
 // the layering order, the key table's own consistency, and round-tripping the effective case.
 #include "case_params.hpp"
 #include "exit_codes.hpp"
+#include "loading_rate.hpp"
 
 #include <gtest/gtest.h>
 
@@ -588,6 +589,8 @@ TEST(CaseParams, EveryChoiceParsesToTheEnumeratorOfItsName) {
     EXPECT_GE(choiceKeys, 9u);  // the nine of 2026-12-06 at least: none dropped, a new one needs no edit here
     EXPECT_EQ(parse("rate_adapt_rule = \"margin\"\n").rate_adapt_rule, RateAdaptRule::margin);
     EXPECT_EQ(parse("").rate_adapt_velocity, RateAdaptVelocity::keep);
+    EXPECT_EQ(parse("").rate_adapt_rho_high, enamel::kRateRhoHigh);  // the rule's own bound is the key's default
+    EXPECT_EQ(parse("rate_adapt_rho_high = 0.04\n").rate_adapt_rho_high, 0.04);
     EXPECT_EQ(parse("rate_adapt_velocity = \"quasi_static\"\n").rate_adapt_velocity, RateAdaptVelocity::quasi_static);
     EXPECT_EQ(parse("deletion_rule = \"all\"\n").deletion_rule, DeletionRule::all);
     EXPECT_EQ(parse("far_field_rod_breaks = \"allow\"\n").far_field_rod_breaks, FarFieldRodBreaks::allow);

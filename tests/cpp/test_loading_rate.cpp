@@ -44,6 +44,28 @@ TEST(LoadingRate, HoldsBetweenTheBoundsOnABurstAndWithoutStrain) {
   EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, RateControlInput{}), 3.0);    // rho undefined
 }
 
+// rate_adapt_rho_high moves the high bound, and the low one with it (a quarter of it): a ratio above the default
+// bound but below the case's is held, one below a quarter of the case's bound raises, one above it halves; the
+// margin rule reads the same bounds. The default's low bound is the former constant 0.0025 exactly.
+TEST(LoadingRate, TheCasesHighBoundMovesBothBounds) {
+  auto at = [](double rho, double rhoHigh, double rows = NAN) {
+    RateControlInput in = interval(rho);
+    in.rhoHigh = rhoHigh;
+    in.rowsToEvent = rows;
+    return in;
+  };
+  EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, at(0.02, kRateRhoHigh)), 1.5);   // the default halves at 0.02
+  EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, at(0.02, 0.04)), 3.0);           // 0.04 holds it
+  EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, at(0.009, kRateRhoHigh)), 3.0);   // the default holds at 0.009
+  EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, at(0.009, 0.04)), 3.75);         // below 0.01: raised
+  EXPECT_DOUBLE_EQ(nextRateMultiplier(3.0, 8.0, at(0.041, 0.04)), 1.5);
+  EXPECT_DOUBLE_EQ(nextRateMultiplierByMargin(3.0, 8.0, 10.0, at(0.02, kRateRhoHigh, 1000.0)), 1.5);
+  EXPECT_DOUBLE_EQ(nextRateMultiplierByMargin(3.0, 8.0, 10.0, at(0.02, 0.04, 1000.0)), 3.0);
+  EXPECT_DOUBLE_EQ(nextRateMultiplierByMargin(3.0, 8.0, 10.0, at(0.009, 0.04, 20.0)), 2.0);  // the forecast's 2
+  EXPECT_EQ(kRateRhoLow, 0.0025);
+  EXPECT_EQ(RateControlInput{}.rhoHigh, kRateRhoHigh);
+}
+
 TEST(LoadingRate, NeverBelowOneNorAboveTheMaximum) {
   EXPECT_DOUBLE_EQ(nextRateMultiplier(8.0, 8.0, interval(1e-4)), 8.0);   // at the maximum: held there
   EXPECT_DOUBLE_EQ(nextRateMultiplier(7.0, 8.0, interval(1e-4)), 8.0);   // 8.75 capped

@@ -25,6 +25,7 @@ TEST(SharedConstants, PrintedAreTheDeclared) {
   EXPECT_EQ(t["kinetic_warn"].value<double>(), kKineticWarn);
   EXPECT_EQ(t["balance_warn"].value<double>(), kBalanceWarn);
   EXPECT_EQ(t["loading_rate"]["rho_low"].value<double>(), kRateRhoLow);
+  EXPECT_EQ(t["loading_rate"]["rho_low_share"].value<double>(), kRateRhoLowShare);
   EXPECT_EQ(t["loading_rate"]["lower"].value<double>(), kRateLower);
 
   const toml::node_view<const toml::node> seal = t["result_seal"];

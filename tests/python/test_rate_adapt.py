@@ -58,23 +58,42 @@ def test_rate_rises_while_loading_elastically(adaptive):
     assert speedup > 1.5
 
 
-def test_each_interval_follows_the_rule(adaptive):
-    """phi at row i+1 is the rule's target set at row i (the ramp ends on the next history row): x1.25 (capped)
-    while elastic and rho < rho_lo, halved (not below 1) after rho > rho_hi or a deletion."""
-    h = adaptive["history"]
+def rule_rows(h, rho_high, rho_low):
+    """Check every history interval against the rule with these bounds; return (raised, lowered, held above
+    the default high bound): phi at row i+1 is the rule's target set at row i (the ramp ends on the next history
+    row)."""
     phi = h["rate_multiplier"]
     rho = h["kinetic_energy_beyond_loading"] / np.maximum(h["strain_energy_beams"] + h["strain_energy_interfaces"], 1e-300)
     deleted = np.diff(h["broken_rod_elements"], prepend=0) > 0
     elastic = (h["da_over_d"] == 0) & (h["broken_rod_elements"] == 0) & (h["failed_interfaces"] == 0)
-    raised = lowered = 0
+    raised = lowered = held_above_default = 0
     for i in range(1, len(phi) - 2):   # the last row is where the run stopped, off the history interval
-        if deleted[i] or rho[i] > RHO_HIGH:
+        if deleted[i] or rho[i] > rho_high:
             assert phi[i + 1] == max(1.0, LOWER * phi[i]), f"row {i}: not halved"
             lowered += 1
-        elif elastic[i] and rho[i] < RHO_LOW:
+        elif elastic[i] and rho[i] < rho_low:
             assert phi[i + 1] == min(8.0, RAISE * phi[i]), f"row {i}: not raised"
             raised += 1
+        elif rho[i] > RHO_HIGH and phi[i] > 1:
+            held_above_default += phi[i + 1] >= phi[i]
+    return raised, lowered, held_above_default
+
+
+def test_each_interval_follows_the_rule(adaptive):
+    """x1.25 (capped) while elastic and rho < rho_lo, halved (not below 1) after rho > rho_hi or a deletion."""
+    raised, lowered, _ = rule_rows(adaptive["history"], RHO_HIGH, RHO_LOW)
     assert raised >= 3 and lowered >= 1, (raised, lowered)
+
+
+def test_case_key_moves_the_rules_bounds(run, tmp_path):
+    """rate_adapt_rho_high = 0.04: halved only above 0.04, raised below 0.01 (a quarter of it), and at least one
+    interval with rho above the default's 0.01 at phi > 1 not lowered (the default would have halved it)."""
+    assert LOADING_RATE["rho_low_share"] == 0.25 and RHO_LOW == LOADING_RATE["rho_low_share"] * RHO_HIGH
+    r = run(*args_for(tmp_path, 8, "--set", "rate_adapt_rho_high=0.04"))
+    assert r.returncode == 0, r.stderr
+    raised, lowered, held = rule_rows(read(tmp_path / "result.h5")["history"], 0.04, 0.01)
+    print(f"rho_high 0.04: raised {raised}, lowered {lowered}, held above 0.01 {held}")
+    assert raised >= 3 and held >= 1, (raised, lowered, held)
 
 
 def test_adaptive_run_stays_quasi_static_and_balanced(adaptive):
