@@ -89,8 +89,8 @@ NodeBlockMatrix elasticInterfaceBlocks(const Model& m, const cohesive::Law& law,
 /// that, the wrench of (law's force - elastic force) of each interface off the elastic branch. An interface
 /// not due adds nothing (it is elastic); a due one is evaluated by the law (lambdaMax updated), adds its
 /// difference when it is off the elastic branch (nothing while on it), and gets its next due drift. A chunk
-/// none of whose interfaces is due (schedule.chunkDue) is not read; a slice with no chunk read gets no wrench written. Adds the
-/// interfaces evaluated to `evaluated`.
+/// none of whose interfaces is due (schedule.chunkDue) is not read; a slice with no chunk read gets no wrench
+/// written. Adds the interfaces evaluated to `evaluated`.
 struct SliceCorrections {
   int failed = 0;       // failed interfaces of the slice
   bool wrench = false;  // the wrench was written (otherwise it is zero, and left as it was)

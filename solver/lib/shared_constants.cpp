@@ -60,8 +60,8 @@ toml::table sharedConstants() {
       {"result_seal", resultSeal()},
       {"run_statuses", namesOf<RunStatus>()},
       {"result_files", resultFiles},
-      {"loading_rate", toml::table{{"rho_high", kRateRhoHigh}, {"rho_low", kRateRhoLow}, {"rho_low_share", kRateRhoLowShare},
-                                   {"raise", kRateRaise},
+      {"loading_rate", toml::table{{"rho_high", kRateRhoHigh}, {"rho_low", kRateRhoLow},
+                                   {"rho_low_share", kRateRhoLowShare}, {"raise", kRateRaise},
                                    {"lower", kRateLower}}},
       {"key_choices", keyChoices()},
   };
