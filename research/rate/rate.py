@@ -21,6 +21,7 @@ import resource
 import subprocess
 import sys
 import time
+import tomllib
 
 import h5py
 import numpy as np
@@ -65,6 +66,12 @@ STUDY4 = {"s4_margin8_h20_qs": margin(8, 20), "s4_margin4_h10_qs": margin(4, 10)
 # against the same references; run order rho 0.04 (both cases), then rho 0.02
 STUDY5 = {f"s5_margin4_h10_qs_rho{tag}": {**margin(4, 10), "rate_adapt_rho_high": rho}
           for tag, rho in (("04", 0.04), ("02", 0.02))}
+# README.md, Study 6: the Rayleigh damping ratio zeta (which sets how fast a burst's ringing decays), at phi = 1 (its own
+# effect) and with study 4's choice; stage A at reduced against s6_phi1 (zeta 0.2, this build), in this order
+STUDY6 = {"s6_phi1": {"rate_adapt_max": 1}, "s6_phi1_z05": {"rate_adapt_max": 1, "zeta": 0.5},
+          "s6_phi1_z10": {"rate_adapt_max": 1, "zeta": 1.0}, "s6_m4": margin(4, 10),
+          "s6_m4_z05": {**margin(4, 10), "zeta": 0.5}, "s6_m4_z10": {**margin(4, 10), "zeta": 1.0}}
+STUDY6_REFERENCE = "s6_phi1"
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
@@ -74,6 +81,7 @@ CANDIDATES.update(STUDY2)
 CANDIDATES.update(STUDY3)
 CANDIDATES.update(STUDY4)
 CANDIDATES.update(STUDY5)
+CANDIDATES.update(STUDY6)
 CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
 # reduced starts as converged does (its preset's own 0.95); the ci smoke run as its preset
 STATIC_START = {"reduced": 0.95, "converged": 0.95, "ci": 0.0}
@@ -95,7 +103,7 @@ def events_at_phi(h5: pathlib.Path) -> dict:
     with h5py.File(h5, "r") as f:
         h = f["history"]
         rods, failed, phi = (np.asarray(h[k]) for k in ("broken_rod_elements", "failed_interfaces", "rate_multiplier"))
-    rows = np.nonzero((np.diff(rods) > 0) | (np.diff(failed) > 0))[0] + 1   # row i: the event in (row i-1, row i]
+    rows = event_rows(rods, failed)   # row i: the event in (row i-1, row i]
 
     def ends(count):
         i = int(np.argmax(count > 0)) if (count > 0).any() else None
@@ -103,6 +111,60 @@ def events_at_phi(h5: pathlib.Path) -> dict:
     at_one = int(sum(phi[i - 1] == 1 and phi[i] == 1 for i in rows))
     return dict(first_rod_break=ends(rods), first_interface_failure=ends(failed), intervals=int(len(rows)),
                 intervals_at_one=at_one, phi_max_reached=float(phi.max()))
+
+
+def event_rows(rods: np.ndarray, failed: np.ndarray) -> np.ndarray:
+    """The history rows i whose interval (row i-1, row i] holds an event (a rod broke or an interface failed)."""
+    return np.nonzero((np.diff(rods) > 0) | (np.diff(failed) > 0))[0] + 1
+
+
+def ringing_decay_rates(time: np.ndarray, kinetic: np.ndarray, events: np.ndarray, quiet_rows: int = 30) -> np.ndarray:
+    """The decay rate of the kinetic energy beyond the loading, -d ln K / dt by least squares, over each quiet
+    stretch (the rows from the largest K within 10 rows after an event row to the row before the next event, at
+    least `quiet_rows` rows between the two events and 20 rows fitted). A mass-proportional damping a M alone
+    makes K decay at the rate a."""
+    rates = []
+    for k, j in zip(events[:-1], events[1:]):
+        if j - k < quiet_rows:
+            continue
+        i0 = k + int(np.argmax(kinetic[k:k + 10]))
+        t, y = time[i0:j - 1], kinetic[i0:j - 1]
+        if len(t) >= 20 and (y > 0).all():
+            rates.append(-np.polyfit(t, np.log(y), 1)[0])
+    return np.asarray(rates)
+
+
+def held_at_one(h5: pathlib.Path, far_rows: int = 40) -> dict:
+    """What holds phi at 1 in crack growth (README.md, Study 6, Why): the history intervals after the first event
+    with phi = 1 at both ends, their steps, and those whose next event is more than `far_rows` rows ahead split by
+    rho = kinetic beyond the loading / strain at the interval's end: above rho_hi (the energy part halves phi), in
+    [rho_lo, rho_hi] (it holds), below (the forecast or the rise's x1.25 a row holds it); and the ringing's decay
+    rate (ringing_decay_rates) against the run's Rayleigh a."""
+    with h5py.File(h5, "r") as f:
+        h = f["history"]
+        get = lambda k: np.asarray(h[k], dtype=float)
+        phi, step, time_, kin = get("rate_multiplier"), get("step"), get("time"), get("kinetic_energy_beyond_loading")
+        rods, failed = get("broken_rod_elements"), get("failed_interfaces")
+        strain = get("strain_energy_beams") + get("strain_energy_interfaces")
+        meta = f["meta"].attrs
+        a = float(meta["rayleigh_a"])
+        case = tomllib.loads(meta["case_toml"]) if "case_toml" in meta else {}
+    rho_hi = float(case.get("rate_adapt_rho_high", 0.01))
+    rho_lo = 0.25 * rho_hi
+    events = event_rows(rods, failed)
+    first = int(events[0]) if len(events) else len(phi)
+    nxt = np.searchsorted(events, np.arange(len(phi)) + 1)
+    to_next = np.where(nxt < len(events), events[np.minimum(nxt, len(events) - 1)] - np.arange(len(phi)), 10**9)
+    i = np.arange(first, len(phi) - 1)
+    i = i[(phi[i] == 1) & (phi[i + 1] == 1)]
+    far = i[to_next[i] > far_rows]
+    rho = kin[far + 1] / np.maximum(strain[far + 1], 1e-300)
+    rates = ringing_decay_rates(time_, kin, events)
+    return dict(steps=int(step[-1]), growth_steps=int(step[-1] - step[first]),
+                steps_at_one=int((step[i + 1] - step[i]).sum()), rows_at_one=int(len(i)), far_rows=int(len(far)),
+                far_above_hi=int((rho > rho_hi).sum()), far_between=int(((rho >= rho_lo) & (rho <= rho_hi)).sum()),
+                far_below_lo=int((rho < rho_lo).sum()), rayleigh_a=a, quiet_stretches=int(len(rates)),
+                decay_over_a=float(np.median(rates) / a) if len(rates) else float("nan"))
 
 
 def s3_holds(ev: dict) -> bool:
@@ -343,6 +405,38 @@ def report5() -> str:
     return "\n".join(judged_table(rws, core_ratio=True)) + "\n\nDecision: " + decision5(rws) + "\n"
 
 
+def rows6(preset: str = "reduced") -> list[dict]:
+    """Study 6's stage A: each of its runs against s6_phi1 of the same case and preset."""
+    out = []
+    for case in CASES:
+        ref = DATA / f"{preset}__{case}__{STUDY6_REFERENCE}.json"
+        ref = json.loads(ref.read_text()) if ref.exists() else None
+        for name in STUDY6:
+            own = DATA / f"{preset}__{case}__{name}.json"
+            if own.exists():
+                out.append(judged_row(preset, case, name, json.loads(own.read_text()), ref))
+    return out
+
+
+def decision6(rws: list[dict]) -> list[str]:
+    """README.md, Study 6, Decision A: the margin candidates with a raised zeta that meet (S2) and (S3) on both cases
+    go to the converged check, the larger zeta first; the phi = 1 rows are the damping's own effect, reported."""
+    go = []
+    for name in ("s6_m4_z10", "s6_m4_z05"):
+        ws = [w for w in rws if w["candidate"] == name]
+        if len(ws) == len(CASES) and all(w.get("same") and w["s3"] for w in ws):
+            go.append(name)
+    return go
+
+
+def report6(preset: str = "reduced") -> str:
+    rws = rows6(preset)
+    go = decision6(rws)
+    return "\n".join(judged_table(rws)) + "\n\nDecision A: " + (
+        ", ".join(go) + " go" + ("es" if len(go) == 1 else "") + " to the converged check" if go else
+        "no raised zeta keeps the R-curve on both cases: none goes to the converged check") + "\n"
+
+
 def report() -> str:
     lines = ["| preset | case | candidate | steps | steps ratio (S1) | core s | mean R rel | R_init rel | rods ref/cand |"
              " L2 | same (S2) | first break / failure phi (S3) | event intervals at phi 1 |", "|" + "---|" * 13]
@@ -373,19 +467,32 @@ def main(argv=None) -> int:
     for p in (one, every):
         p.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     rep = sub.add_parser("report", help="the table from data/")
+    diag = sub.add_parser("held", help="what holds phi at 1 in crack growth, from result files (README.md, Study 6)")
+    diag.add_argument("results", nargs="+", type=pathlib.Path)
     chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
     chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     for p in (every, rep):
-        p.add_argument("--study", type=int, choices=(1, 2, 3, 4, 5), default=1)
+        p.add_argument("--study", type=int, choices=(1, 2, 3, 4, 5, 6), default=1)
     a = ap.parse_args(argv)
     if a.cmd == "report":
         print(report() if a.study == 1 else report4() if a.study == 4 else report5() if a.study == 5 else
-              report2(names=STUDY_NAMES[a.study]), end="")
+              report6() if a.study == 6 else report2(names=STUDY_NAMES[a.study]), end="")
+        return 0
+    if a.cmd == "held":
+        for h5 in a.results:
+            print(h5, json.dumps(held_at_one(h5)))
         return 0
     if a.cmd == "check":
         return 0 if check(a.binary)["reuse_study1"] else 1
     if a.cmd == "run":
         return run_one(a.binary, a.preset, a.case, a.candidate)
+    if a.study == 6:   # README.md, Study 6, stage A's order: each case, its runs in the table's order
+        for case in CASES:
+            for name in STUDY6:
+                rc = run_one(a.binary, a.preset, case, name)
+                if rc != 0:
+                    return rc
+        return 0
     if a.study in STUDY_NAMES:
         return all2(a.binary, a.preset, STUDY_NAMES[a.study])
     if a.study in (4, 5):   # README.md, Study 4's (5's) order: each candidate on both cases, in the table's order

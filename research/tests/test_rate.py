@@ -4,6 +4,7 @@ not run again)."""
 import json
 import subprocess
 
+import numpy as np
 import pytest
 
 from research.rate import rate
@@ -64,3 +65,24 @@ def test_study5_replaces_study4s_choice_only_when_eligible_and_saving_more():
         .startswith(f"{rho02} replaces")                                 # rho 0.04 not the same on theta15
     assert rate.decision5(s4 + rows(rho04, (2.6, 1.6), (True, True))).startswith("none is eligible")   # 1.6 < 1.71
     assert rate.CANDIDATES[rho04]["rate_adapt_rho_high"] == 0.04
+
+
+def test_ringing_decay_rate_is_the_mass_damping_of_a_decaying_ringing():
+    """README.md, Study 6, Why: a kinetic energy that rings down as exp(-a t) between two events is measured at the
+    rate a; a stretch shorter than the quiet rows is not measured."""
+    a, t = 0.003, np.arange(400) * 10.0
+    kinetic = np.exp(-a * t) * (1.5 + np.cos(0.05 * t))        # the energy swings between kinetic and strain
+    rates = rate.ringing_decay_rates(t, kinetic, np.array([5, 300, 320]))
+    assert len(rates) == 1 and rates[0] == pytest.approx(a, rel=0.05)
+    assert len(rate.ringing_decay_rates(t, kinetic, np.array([5, 30]))) == 0
+
+
+def test_study6_sends_only_a_raised_zeta_the_same_on_both_cases():
+    """README.md, Study 6, Decision A: a margin candidate with a raised zeta goes to the converged check only when it
+    meets (S2) and (S3) on both cases; the phi = 1 rows decide nothing; the larger zeta first."""
+    def rows(name, same, s3=(True, True)):
+        return [dict(candidate=name, case=c, same=x, s3=y) for c, x, y in zip(rate.CASES, same, s3)]
+    rws = rows("s6_phi1_z10", (False, False)) + rows("s6_m4_z05", (True, True)) + rows("s6_m4_z10", (True, True))
+    assert rate.decision6(rws) == ["s6_m4_z10", "s6_m4_z05"]
+    assert rate.decision6(rows("s6_m4_z10", (True, False)) + rows("s6_m4_z05", (True, True), (True, False))) == []
+    assert rate.CANDIDATES["s6_m4_z05"] == {**rate.CANDIDATES["s4_margin4_h10_qs"], "zeta": 0.5}
