@@ -430,11 +430,16 @@ def decision6(rws: list[dict]) -> list[str]:
 
 
 def report6(preset: str = "reduced") -> str:
+    """Stage A's table and decision; then, once a converged run is recorded, stage B's (study 5's table and rule)."""
     rws = rows6(preset)
     go = decision6(rws)
-    return "\n".join(judged_table(rws)) + "\n\nDecision A: " + (
+    out = "\n".join(judged_table(rws)) + "\n\nDecision A: " + (
         ", ".join(go) + " go" + ("es" if len(go) == 1 else "") + " to the converged check" if go else
         "no raised zeta keeps the R-curve on both cases: none goes to the converged check") + "\n"
+    stage_b = rows4((STUDY4_CHOICE, "s6_m4_z10", "s6_m4_z05"))
+    if any(w["candidate"] != STUDY4_CHOICE for w in stage_b):
+        out += "\n" + "\n".join(judged_table(stage_b, core_ratio=True)) + "\n\nDecision B: " + decision5(stage_b) + "\n"
+    return out
 
 
 def report() -> str:
