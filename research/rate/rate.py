@@ -439,6 +439,12 @@ def report6(preset: str = "reduced") -> str:
     stage_b = rows4((STUDY4_CHOICE, "s6_m4_z10", "s6_m4_z05"))
     if any(w["candidate"] != STUDY4_CHOICE for w in stage_b):
         out += "\n" + "\n".join(judged_table(stage_b, core_ratio=True)) + "\n\nDecision B: " + decision5(stage_b) + "\n"
+    stage_c = rows4(("s6_phi1_z05",))
+    if stage_c:   # README.md, Study 6, stage C: the damping's own effect at converged, against the records
+        out += "\nStage C (phi = 1, zeta 0.5 against the converged records at zeta 0.2):\n\n" + \
+            "\n".join(judged_table(stage_c, core_ratio=True)) + "\n\n" + "\n".join(
+                f"- {w['case']}: the damping's choice is {'arbitrary' if w['same'] else 'not arbitrary'} at 80 x 80 d"
+                for w in stage_c) + "\n"
     return out
 
 
