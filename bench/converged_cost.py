@@ -47,6 +47,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tomllib
 
 import h5py
 import numpy as np
@@ -55,6 +56,7 @@ import bench
 from bench import jobs as bench_jobs
 from bench import run_bench
 from enamel_results import metrics, paths, results
+from enamel_results import constants
 from pipeline.phases import set_tag
 
 CASES = ("theta30_s21.4_e10_cv0", "theta15_s21.4_e10_cv0", "theta30_s28.5_e10_cv0.3_seed1")
@@ -62,6 +64,7 @@ BASELINE_COMMIT = "c09beab"
 PRESET = "converged"
 RATIO_GOAL = 3.0
 TOLERANCE = metrics.TOL_RATE_SPEED
+FAR_ROWS = 40   # ringing_holds: an interval at phi = 1 whose next event is more rows ahead than this is "far from events"
 RUNS = bench.RUNS / "converged_cost"
 TABLE = "converged_cost"             # OUT/converged_cost.md and .csv
 CHECKPOINT_EVERY_S = 300.0
@@ -198,6 +201,66 @@ def unit_rate_share(result_file: pathlib.Path) -> float | None:
     return float(np.diff(step)[at_one].sum() / (step[-1] - step[0]))
 
 
+def event_rows(rods: np.ndarray, failed: np.ndarray) -> np.ndarray:
+    """The history rows i whose interval (row i-1, row i] holds an event (a rod broke or an interface failed)."""
+    return np.nonzero((np.diff(rods) > 0) | (np.diff(failed) > 0))[0] + 1
+
+
+def ringing_decay_rates(time: np.ndarray, kinetic: np.ndarray, events: np.ndarray, quiet_rows: int = 30) -> np.ndarray:
+    """The decay rate of the kinetic energy beyond the loading, -d ln K / dt by least squares, over each quiet
+    stretch: from the largest K within 10 rows after an event row to the row before the next event, at least
+    `quiet_rows` rows between the two events and 20 rows fitted. A mass-proportional damping a M alone makes K
+    decay at the rate a."""
+    rates = []
+    for k, j in zip(events[:-1], events[1:]):
+        if j - k < quiet_rows:
+            continue
+        i0 = k + int(np.argmax(kinetic[k:k + 10]))
+        t, y = time[i0:j - 1], kinetic[i0:j - 1]
+        if len(t) >= 20 and (y > 0).all():
+            rates.append(-np.polyfit(t, np.log(y), 1)[0])
+    return np.asarray(rates)
+
+
+def ringing_holds(result_file: pathlib.Path, far_rows: int = FAR_ROWS) -> dict | None:
+    """What holds an adaptive-rate run at phi = 1 in crack growth (after its first event): the history intervals
+    with phi = 1 at both ends whose next event is more than `far_rows` rows ahead (`far`), and how many of those
+    end with rho = kinetic energy beyond the loading / strain energy at or above the rule's low bound (`ringing`:
+    the energy part holds phi; the rest the forecast or the rise's pace), of them above the high bound
+    (`above_high`: the energy part halves phi); the steps in crack growth and those at phi = 1 there; and the
+    median decay rate of that kinetic energy between events over the run's Rayleigh a (`decay_over_a`;
+    ringing_decay_rates). None without the adaptive-rate column or without an event."""
+    with h5py.File(result_file, "r") as f:
+        h = f["history"]
+        if "rate_multiplier" not in h:
+            return None
+        get = lambda k: np.asarray(h[k], dtype=float)
+        phi, time, kinetic = get("rate_multiplier"), get("time"), get("kinetic_energy_beyond_loading")
+        step = get("step")
+        strain = get("strain_energy_beams") + get("strain_energy_interfaces")
+        events = event_rows(get("broken_rod_elements"), get("failed_interfaces"))
+        meta = f["meta"].attrs
+        a = float(meta["rayleigh_a"])
+        case = tomllib.loads(meta["case_toml"]) if "case_toml" in meta else {}
+    if len(events) == 0:
+        return None
+    rate = constants.LOADING_RATE
+    rho_high = float(case.get("rate_adapt_rho_high", rate["rho_high"]))
+    rho_low = rate["rho_low_share"] * rho_high
+    rows = np.arange(len(phi))
+    nxt = np.searchsorted(events, rows + 1)
+    to_next = np.where(nxt < len(events), events[np.minimum(nxt, len(events) - 1)] - rows, np.iinfo(np.int64).max)
+    i = np.arange(events[0], len(phi) - 1)
+    at_one = i[(phi[i] == 1) & (phi[i + 1] == 1)]
+    far = at_one[to_next[at_one] > far_rows]
+    rho = kinetic[far + 1] / np.maximum(strain[far + 1], np.finfo(float).tiny)
+    rates = ringing_decay_rates(time, kinetic, events)
+    return dict(growth_steps=int(step[-1] - step[events[0]]), steps_at_one=int((step[at_one + 1] - step[at_one]).sum()),
+                far=int(len(far)), ringing=int((rho >= rho_low).sum()), above_high=int((rho > rho_high).sum()),
+                quiet_stretches=int(len(rates)),
+                decay_over_a=float(np.median(rates) / a) if len(rates) and a > 0 else math.nan)
+
+
 def case_row(case: str, base: pathlib.Path, ref: pathlib.Path, new: pathlib.Path, goal: float = RATIO_GOAL) -> dict:
     """One case's row: the three runs' numbers (the reference's folder may be the new one's), the ratio of cost
     (baseline / new) and its factors, the levers' own ratio (reference / new), the new R-curve against the
@@ -218,6 +281,10 @@ def case_row(case: str, base: pathlib.Path, ref: pathlib.Path, new: pathlib.Path
     share = unit_rate_share(new / paths.RESULT_NAMES["completed"])
     if share:
         row.update(new_unit_rate_share=share, ratio_bound=ratio / share)
+    held = ringing_holds(new / paths.RESULT_NAMES["completed"])
+    if held:
+        row.update(new_far_at_one=held["far"], new_far_ringing=held["ringing"],
+                   new_ringing_decay_over_a=held["decay_over_a"])
     if same is not None:
         row.update(range_hi=same.hi, R_mean_reference=same.mean_a, R_mean_new=same.mean_b, R_mean_rel=same.mean_rel,
                    R_init_rel=same.init_rel, rods_reference=same.rods_a, rods_new=same.rods_b, rcurve_l2=same.l2,
@@ -246,15 +313,19 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"solver process's CPU time (user + system) summed over its pieces; ratio = baseline / new = fewer steps x "
          f"cheaper step (core-s per step and DOF); levers = reference / new; at phi = 1: the new run's share of "
          f"steps in history intervals at loading-rate multiplier 1 at both ends, and the ratio / that share, the most "
-         f"a higher phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column). Same R-curve, new "
+         f"a higher phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column); held by the "
+         f"ringing: of the new run's intervals at phi = 1 in crack growth whose next event (a rod break or an interface "
+         f"failure) is more than {FAR_ROWS} rows ahead, those that end with kinetic energy beyond the loading / strain "
+         f"energy at or above the rule's low bound (the energy part holds phi at 1), and the median decay rate of that "
+         f"energy between events over the Rayleigh a (mass-proportional damping alone: 1). Same R-curve, new "
          f"against the reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged "
          f"over (0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
          f"pointwise L2 reported, not deciding; the baseline's R mean against the new one reported beside it (its "
          f"model is not today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
          "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 "
-         "(bound) | steps (baseline / new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | "
+         "(bound) | held by the ringing (decay / a) | steps (baseline / new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | "
          "broken rods (reference / new) | L2 | same R-curve | baseline's R mean (diff) | verdict |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     L += [table_line(r) for r in rows]
     L += ["", "Per run (pieces: solver processes of a resumed run; started: the first piece, UTC):", ""]
     for r in rows:
@@ -279,13 +350,20 @@ def unit_rate_cell(r: dict) -> str:
     return f"{share:.0%} ({r['ratio_bound']:.2f})" if share else "n/a"
 
 
+def ringing_cell(r: dict) -> str:
+    """Of the new run's intervals at phi = 1 far from events, those the ringing holds, and its decay / a; or n/a."""
+    if r.get("new_far_at_one") is None:
+        return "n/a"
+    return f"{r['new_far_ringing']} / {r['new_far_at_one']} ({fmt(r.get('new_ringing_decay_over_a'), '.2f')})"
+
+
 def table_line(r: dict) -> str:
     """One case's line of the table."""
     if r.get("status") != "complete":
-        return f"| {r['case']} |" + " |" * 15 + f" {r['verdict']} |"
+        return f"| {r['case']} |" + " |" * 16 + f" {r['verdict']} |"
     dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
     return (f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
-            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {unit_rate_cell(r)} | "
+            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {unit_rate_cell(r)} | {ringing_cell(r)} | "
             f"{r['baseline_steps']} / "
             f"{r['new_steps']} | {dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_reference'), '.4g')} "
             f"/ {fmt(r.get('R_mean_new'), '.4g')} ({pct(r.get('R_mean_rel'))}) | {pct(r.get('R_init_rel'))} | "

@@ -21,12 +21,12 @@ import resource
 import subprocess
 import sys
 import time
-import tomllib
 
 import h5py
 import numpy as np
 
 from bench import records
+from bench.converged_cost import event_rows, ringing_holds
 from enamel_results import metrics, paths
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -111,60 +111,6 @@ def events_at_phi(h5: pathlib.Path) -> dict:
     at_one = int(sum(phi[i - 1] == 1 and phi[i] == 1 for i in rows))
     return dict(first_rod_break=ends(rods), first_interface_failure=ends(failed), intervals=int(len(rows)),
                 intervals_at_one=at_one, phi_max_reached=float(phi.max()))
-
-
-def event_rows(rods: np.ndarray, failed: np.ndarray) -> np.ndarray:
-    """The history rows i whose interval (row i-1, row i] holds an event (a rod broke or an interface failed)."""
-    return np.nonzero((np.diff(rods) > 0) | (np.diff(failed) > 0))[0] + 1
-
-
-def ringing_decay_rates(time: np.ndarray, kinetic: np.ndarray, events: np.ndarray, quiet_rows: int = 30) -> np.ndarray:
-    """The decay rate of the kinetic energy beyond the loading, -d ln K / dt by least squares, over each quiet
-    stretch (the rows from the largest K within 10 rows after an event row to the row before the next event, at
-    least `quiet_rows` rows between the two events and 20 rows fitted). A mass-proportional damping a M alone
-    makes K decay at the rate a."""
-    rates = []
-    for k, j in zip(events[:-1], events[1:]):
-        if j - k < quiet_rows:
-            continue
-        i0 = k + int(np.argmax(kinetic[k:k + 10]))
-        t, y = time[i0:j - 1], kinetic[i0:j - 1]
-        if len(t) >= 20 and (y > 0).all():
-            rates.append(-np.polyfit(t, np.log(y), 1)[0])
-    return np.asarray(rates)
-
-
-def held_at_one(h5: pathlib.Path, far_rows: int = 40) -> dict:
-    """What holds phi at 1 in crack growth (README.md, Study 6, Why): the history intervals after the first event
-    with phi = 1 at both ends, their steps, and those whose next event is more than `far_rows` rows ahead split by
-    rho = kinetic beyond the loading / strain at the interval's end: above rho_hi (the energy part halves phi), in
-    [rho_lo, rho_hi] (it holds), below (the forecast or the rise's x1.25 a row holds it); and the ringing's decay
-    rate (ringing_decay_rates) against the run's Rayleigh a."""
-    with h5py.File(h5, "r") as f:
-        h = f["history"]
-        get = lambda k: np.asarray(h[k], dtype=float)
-        phi, step, time_, kin = get("rate_multiplier"), get("step"), get("time"), get("kinetic_energy_beyond_loading")
-        rods, failed = get("broken_rod_elements"), get("failed_interfaces")
-        strain = get("strain_energy_beams") + get("strain_energy_interfaces")
-        meta = f["meta"].attrs
-        a = float(meta["rayleigh_a"])
-        case = tomllib.loads(meta["case_toml"]) if "case_toml" in meta else {}
-    rho_hi = float(case.get("rate_adapt_rho_high", 0.01))
-    rho_lo = 0.25 * rho_hi
-    events = event_rows(rods, failed)
-    first = int(events[0]) if len(events) else len(phi)
-    nxt = np.searchsorted(events, np.arange(len(phi)) + 1)
-    to_next = np.where(nxt < len(events), events[np.minimum(nxt, len(events) - 1)] - np.arange(len(phi)), 10**9)
-    i = np.arange(first, len(phi) - 1)
-    i = i[(phi[i] == 1) & (phi[i + 1] == 1)]
-    far = i[to_next[i] > far_rows]
-    rho = kin[far + 1] / np.maximum(strain[far + 1], 1e-300)
-    rates = ringing_decay_rates(time_, kin, events)
-    return dict(steps=int(step[-1]), growth_steps=int(step[-1] - step[first]),
-                steps_at_one=int((step[i + 1] - step[i]).sum()), rows_at_one=int(len(i)), far_rows=int(len(far)),
-                far_above_hi=int((rho > rho_hi).sum()), far_between=int(((rho >= rho_lo) & (rho <= rho_hi)).sum()),
-                far_below_lo=int((rho < rho_lo).sum()), rayleigh_a=a, quiet_stretches=int(len(rates)),
-                decay_over_a=float(np.median(rates) / a) if len(rates) else float("nan"))
 
 
 def s3_holds(ev: dict) -> bool:
@@ -478,7 +424,8 @@ def main(argv=None) -> int:
     for p in (one, every):
         p.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
     rep = sub.add_parser("report", help="the table from data/")
-    diag = sub.add_parser("held", help="what holds phi at 1 in crack growth, from result files (README.md, Study 6)")
+    diag = sub.add_parser("held", help="what holds phi at 1 in crack growth, from result files (README.md, Study 6; "
+                                       "bench.converged_cost.ringing_holds)")
     diag.add_argument("results", nargs="+", type=pathlib.Path)
     chk = sub.add_parser("check", help="study 2: does this build reproduce study 1's phi1 and margin8 (theta30)?")
     chk.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)))
@@ -491,7 +438,7 @@ def main(argv=None) -> int:
         return 0
     if a.cmd == "held":
         for h5 in a.results:
-            print(h5, json.dumps(held_at_one(h5)))
+            print(h5, json.dumps(ringing_holds(h5)))
         return 0
     if a.cmd == "check":
         return 0 if check(a.binary)["reuse_study1"] else 1

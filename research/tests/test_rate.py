@@ -4,7 +4,6 @@ not run again)."""
 import json
 import subprocess
 
-import numpy as np
 import pytest
 
 from research.rate import rate
@@ -65,16 +64,6 @@ def test_study5_replaces_study4s_choice_only_when_eligible_and_saving_more():
         .startswith(f"{rho02} replaces")                                 # rho 0.04 not the same on theta15
     assert rate.decision5(s4 + rows(rho04, (2.6, 1.6), (True, True))).startswith("none is eligible")   # 1.6 < 1.71
     assert rate.CANDIDATES[rho04]["rate_adapt_rho_high"] == 0.04
-
-
-def test_ringing_decay_rate_is_the_mass_damping_of_a_decaying_ringing():
-    """README.md, Study 6, Why: a kinetic energy that rings down as exp(-a t) between two events is measured at the
-    rate a; a stretch shorter than the quiet rows is not measured."""
-    a, t = 0.003, np.arange(400) * 10.0
-    kinetic = np.exp(-a * t) * (1.5 + np.cos(0.05 * t))        # the energy swings between kinetic and strain
-    rates = rate.ringing_decay_rates(t, kinetic, np.array([5, 300, 320]))
-    assert len(rates) == 1 and rates[0] == pytest.approx(a, rel=0.05)
-    assert len(rate.ringing_decay_rates(t, kinetic, np.array([5, 30]))) == 0
 
 
 def test_study6_sends_only_a_raised_zeta_the_same_on_both_cases():

@@ -12,6 +12,7 @@ import sys
 import time
 
 import h5py
+import numpy as np
 import pytest
 
 from conftest import ROOT
@@ -156,7 +157,8 @@ def test_unit_rate_share(tmp_path):
 
 
 def test_table_from_crafted_numbers(tmp_path):
-    rows = [dict(crafted_row("a", 1376.0, 1376.0 / 2.9, True), new_unit_rate_share=0.5, ratio_bound=5.8),
+    rows = [dict(crafted_row("a", 1376.0, 1376.0 / 2.9, True), new_unit_rate_share=0.5, ratio_bound=5.8,
+                 new_far_at_one=681, new_far_ringing=599, new_ringing_decay_over_a=1.077),
             crafted_row("b", 1376.0, 400.0, False),
             crafted_row("c", 1376.0, 1376.0 / 3.2, True), dict(case="d", status="incomplete", met=False,
                                                              verdict=converged_cost.verdict(math.nan, None)[1])]
@@ -169,9 +171,53 @@ def test_table_from_crafted_numbers(tmp_path):
     assert "| **2.90** |" in lines["a"] and "not met: ratio 2.90 < 3" in lines["a"]
     assert "| **3.44** |" in lines["b"] and "not met: not the same R-curve (R mean -2.5%)" in lines["b"]
     assert "| **3.20** |" in lines["c"] and lines["c"].rstrip().endswith("| True | 7.1 (-8.45%) | met |")
-    assert "| 50% (5.80) |" in lines["a"] and "| n/a |" in lines["b"]
+    assert "| 50% (5.80) | 599 / 681 (1.08) |" in lines["a"] and "| n/a | n/a |" in lines["b"]
     assert "| 2.64 |" in lines["a"]           # the levers' own ratio, reference / new: (1376 / 1.1) / (1376 / 2.9)
     assert "no comparison" in lines["d"]
     assert "not the converged table" not in md and "G = 10" in md and "c09beab" in md
     got = list(csv.DictReader(open(csv_path)))
     assert [r["met"] for r in got] == ["False", "False", "True", "False"]
+
+
+def test_ringing_decay_rate_is_the_mass_damping_of_a_decaying_ringing():
+    """A kinetic energy that rings down as exp(-a t) between two events is measured at the rate a; a stretch shorter
+    than the quiet rows is not measured."""
+    a, t = 0.003, np.arange(400) * 10.0
+    kinetic = np.exp(-a * t) * (1.5 + np.cos(0.05 * t))        # the energy swings between kinetic and strain
+    rates = converged_cost.ringing_decay_rates(t, kinetic, np.array([5, 300, 320]))
+    assert len(rates) == 1 and rates[0] == pytest.approx(a, rel=0.05)
+    assert len(converged_cost.ringing_decay_rates(t, kinetic, np.array([5, 30]))) == 0
+
+
+def test_ringing_holds_counts_the_rows_at_phi_one_far_from_events(tmp_path):
+    """Rows after the first event at phi = 1 at both ends whose next event is more than FAR_ROWS rows ahead, split by
+    rho against the rule's bounds (the case's rate_adapt_rho_high, here 0.02: low 0.005); rows before the first
+    event, near an event or at phi > 1 are not counted."""
+    n, far = 200, converged_cost.FAR_ROWS
+    rods = np.zeros(n)
+    rods[10:] = 1                       # events at rows 10 and 10 + far + 30
+    rods[10 + far + 30:] = 2
+    phi = np.ones(n)
+    phi[100:] = 2.0                     # after row 100 no interval is at phi = 1
+    kinetic = np.full(n, 0.001)         # rho 0.001 < 0.005: the forecast's
+    kinetic[12:16] = 0.03               # rho 0.03 > 0.02: above the high bound (rows 11-14 end there)
+    kinetic[16:20] = 0.01               # between the bounds
+    path = tmp_path / "result.h5"
+    with h5py.File(path, "w") as f:
+        for k, v in dict(rate_multiplier=phi, time=np.arange(n) * 10.0, step=np.arange(n) * 100,
+                         kinetic_energy_beyond_loading=kinetic, strain_energy_beams=np.ones(n),
+                         strain_energy_interfaces=np.zeros(n), broken_rod_elements=rods,
+                         failed_interfaces=np.zeros(n)).items():
+            f[f"history/{k}"] = v
+    with h5py.File(path, "a") as f:
+        f.require_group("meta").attrs["rayleigh_a"] = 0.01
+        f["meta"].attrs["case_toml"] = "rate_adapt_rho_high = 0.02\n"
+    held = converged_cost.ringing_holds(path)
+    # intervals i in [10, 99) at phi 1; the next event (row 80) more than 40 rows ahead for i < 40, none after 80
+    expected_far = list(range(10, 40)) + list(range(80, 99))
+    assert held["far"] == len(expected_far)
+    assert held["above_high"] == 4 and held["ringing"] == 8     # rows 11-14 above, 15-18 between
+    assert held["steps_at_one"] == 100 * (99 - 10) and held["growth_steps"] == 100 * (n - 1 - 10)
+    with h5py.File(path, "a") as f:
+        del f["history/rate_multiplier"]
+    assert converged_cost.ringing_holds(path) is None
