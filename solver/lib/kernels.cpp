@@ -373,6 +373,7 @@ void checkStressRatiosForBeams(const Model& m, const Materials& mat, const VecX&
     computeStressRatiosForBeams(m, mat, q, beamBroken, ratio);
     schedule.step = -1;
     schedule.computed = ne;
+    schedule.visitedChunks = (ne + kStressCheckChunk - 1) / kStressCheckChunk;  // every element read
     schedule.largestRatio = 0;
     for (double r : ratio) schedule.largestRatio = std::max(schedule.largestRatio, r);
     return;
