@@ -72,6 +72,11 @@ STUDY6 = {"s6_phi1": {"rate_adapt_max": 1}, "s6_phi1_z05": {"rate_adapt_max": 1,
           "s6_phi1_z10": {"rate_adapt_max": 1, "zeta": 1.0}, "s6_m4": margin(4, 10),
           "s6_m4_z05": {**margin(4, 10), "zeta": 0.5}, "s6_m4_z10": {**margin(4, 10), "zeta": 1.0}}
 STUDY6_REFERENCE = "s6_phi1"
+# stage D: the damping where the rate does not move the R-curve (theta30's phases 1/2 and 3/4), against stage 7's runs
+# of research/tip at zeta 0.2
+STUDY6D = {f"s6_phi1_z05_p{phase:g}": {"rate_adapt_max": 1, "zeta": 0.5, "crisscross_phase": phase}
+           for phase in (0.5, 0.75)}
+TIP_DATA = HERE.parent / "tip" / "data"
 # study 2's candidates whose keys are a study 1 candidate's: its record stands for them when `check` passes
 STUDY1_AS = {"phi1_s2": "phi1", "margin8_h10_keep": "margin8", "margin4_h10_keep": "margin4",
              "energy8_keep": "energy8", "energy4_keep": "energy4"}
@@ -82,6 +87,7 @@ CANDIDATES.update(STUDY3)
 CANDIDATES.update(STUDY4)
 CANDIDATES.update(STUDY5)
 CANDIDATES.update(STUDY6)
+CANDIDATES.update(STUDY6D)
 CANDIDATES.update({name: CANDIDATES[old] for name, old in STUDY1_AS.items()})
 # reduced starts as converged does (its preset's own 0.95); the ci smoke run as its preset
 STATIC_START = {"reduced": 0.95, "converged": 0.95, "ci": 0.0}
@@ -375,6 +381,19 @@ def decision6(rws: list[dict]) -> list[str]:
     return go
 
 
+def decision6d(rws: list[dict]) -> str:
+    """README.md, Study 6, stage D's reading: both phases not the same: the damping is not arbitrary at 80 d; both
+    the same: stage C's shift is phase 0's own sensitivity; otherwise undecided."""
+    same = [bool(w.get("same")) for w in rws]
+    if len(same) < len(STUDY6D):
+        return "Stage D: not complete"
+    if not any(same):
+        return "Stage D: both phases move: the damping's choice is not arbitrary at 80 x 80 d"
+    if all(same):
+        return "Stage D: both phases the same: stage C's shift is phase 0's own sensitivity; arbitrary for these phases"
+    return "Stage D: one phase moves and one does not: undecided"
+
+
 def report6(preset: str = "reduced") -> str:
     """Stage A's table and decision; then, once a converged run is recorded, stage B's (study 5's table and rule)."""
     rws = rows6(preset)
@@ -385,6 +404,15 @@ def report6(preset: str = "reduced") -> str:
     stage_b = rows4((STUDY4_CHOICE, "s6_m4_z10", "s6_m4_z05"))
     if any(w["candidate"] != STUDY4_CHOICE for w in stage_b):
         out += "\n" + "\n".join(judged_table(stage_b, core_ratio=True)) + "\n\nDecision B: " + decision5(stage_b) + "\n"
+    stage_d = []
+    for name, keys in STUDY6D.items():
+        own = DATA / f"converged__{CASES[0]}__{name}.json"
+        if own.exists():
+            ref = json.loads((TIP_DATA / f"s80_G9_cut_p{keys['crisscross_phase']:g}.json").read_text())
+            stage_d.append(judged_row("converged", CASES[0], name, json.loads(own.read_text()), ref))
+    if stage_d:
+        out += "\nStage D (theta30's phases 1/2 and 3/4, phi = 1, zeta 0.5 against research/tip's stage 7 runs):\n\n" + \
+            "\n".join(judged_table(stage_d)) + "\n\n" + decision6d(stage_d) + "\n"
     stage_c = rows4(("s6_phi1_z05",))
     if stage_c:   # README.md, Study 6, stage C: the damping's own effect at converged, against the records
         out += "\nStage C (phi = 1, zeta 0.5 against the converged records at zeta 0.2):\n\n" + \

@@ -75,3 +75,14 @@ def test_study6_sends_only_a_raised_zeta_the_same_on_both_cases():
     assert rate.decision6(rws) == ["s6_m4_z10", "s6_m4_z05"]
     assert rate.decision6(rows("s6_m4_z10", (True, False)) + rows("s6_m4_z05", (True, True), (True, False))) == []
     assert rate.CANDIDATES["s6_m4_z05"] == {**rate.CANDIDATES["s4_margin4_h10_qs"], "zeta": 0.5}
+
+
+def test_study6_stage_d_reading():
+    """README.md, Study 6, stage D: both phases moved: not arbitrary; both the same: phase 0's sensitivity; else
+    undecided; fewer than both: not complete."""
+    row = lambda same: dict(same=same)
+    assert "not arbitrary" in rate.decision6d([row(False), row(False)])
+    assert "phase 0's own sensitivity" in rate.decision6d([row(True), row(True)])
+    assert "undecided" in rate.decision6d([row(True), row(False)])
+    assert "not complete" in rate.decision6d([row(False)])
+    assert rate.CANDIDATES["s6_phi1_z05_p0.75"] == {"rate_adapt_max": 1, "zeta": 0.5, "crisscross_phase": 0.75}
