@@ -473,28 +473,22 @@ def main(argv=None) -> int:
     if a.cmd == "run":
         return run_one(a.binary, a.preset, a.case, a.candidate)
     if a.study == 6:   # README.md, Study 6, stage A's order: each case, its runs in the table's order
-        for case in CASES:
-            for name in STUDY6:
-                rc = run_one(a.binary, a.preset, case, name)
-                if rc != 0:
-                    return rc
-        return 0
+        return run_each(a.binary, [(a.preset, case, name) for case in CASES for name in STUDY6])
     if a.study in STUDY_NAMES:
         return all2(a.binary, a.preset, STUDY_NAMES[a.study])
     if a.study in (4, 5):   # README.md, Study 4's (5's) order: each candidate on both cases, in the table's order
-        for name in (STUDY4 if a.study == 4 else STUDY5):
-            for case in CASES:
-                rc = run_one(a.binary, "converged", case, name)
-                if rc != 0:
-                    return rc
-        return 0
-    for case in CASES:
-        for cand in STUDY1:
-            rc = run_one(a.binary, a.preset, case, cand)
-            if rc != 0:
-                return rc
-    return 0
+        return run_each(a.binary, [("converged", case, name) for name in (STUDY4 if a.study == 4 else STUDY5)
+                                   for case in CASES])
+    return run_each(a.binary, [(a.preset, case, cand) for case in CASES for cand in STUDY1])
 
+
+def run_each(binary: str, runs: list[tuple[str, str, str]]) -> int:
+    """run_one for each (preset, case, candidate) in order; the first failure's status stops the rest."""
+    for preset, case, name in runs:
+        rc = run_one(binary, preset, case, name)
+        if rc != 0:
+            return rc
+    return 0
 
 if __name__ == "__main__":
     sys.exit(main())
