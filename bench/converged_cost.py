@@ -64,7 +64,7 @@ BASELINE_COMMIT = "c09beab"
 PRESET = "converged"
 RATIO_GOAL = 3.0
 TOLERANCE = metrics.TOL_RATE_SPEED
-FAR_ROWS = 40   # ringing_holds: an interval at phi = 1 whose next event is more rows ahead than this is "far from events"
+FAR_ROWS = 40   # ringing_holds: an interval at phi = 1 whose next event is more rows ahead is "far from events"
 RUNS = bench.RUNS / "converged_cost"
 TABLE = "converged_cost"             # OUT/converged_cost.md and .csv
 CHECKPOINT_EVERY_S = 300.0
@@ -314,16 +314,18 @@ def markdown(rows: list[dict], header: dict) -> str:
          f"cheaper step (core-s per step and DOF); levers = reference / new; at phi = 1: the new run's share of "
          f"steps in history intervals at loading-rate multiplier 1 at both ends, and the ratio / that share, the most "
          f"a higher phi_max could reach while those steps stay at 1 (n/a: no adaptive-rate column); held by the "
-         f"ringing: of the new run's intervals at phi = 1 in crack growth whose next event (a rod break or an interface "
-         f"failure) is more than {FAR_ROWS} rows ahead, those that end with kinetic energy beyond the loading / strain "
-         f"energy at or above the rule's low bound (the energy part holds phi at 1), and the median decay rate of that "
-         f"energy between events over the Rayleigh a (mass-proportional damping alone: 1). Same R-curve, new "
+         f"ringing: of the new run's intervals at phi = 1 in crack growth whose next event (a rod break or an "
+         f"interface failure) is more than {FAR_ROWS} rows ahead, those that end with kinetic energy beyond the "
+         f"loading / strain energy at or above the rule's low bound (the energy part holds phi at 1), and the median "
+         f"decay rate of that energy between events over the Rayleigh a (mass-proportional damping alone: 1). Same "
+         f"R-curve, new "
          f"against the reference (deciding): `enamel_results.metrics.same_rcurve` at {TOLERANCE:.0%} (R averaged "
          f"over (0,30] d and R_init; broken rods within {metrics.ROD_REL_TOL:.0%} or {metrics.ROD_ABS_TOL}); the "
          f"pointwise L2 reported, not deciding; the baseline's R mean against the new one reported beside it (its "
          f"model is not today's). Goal: ratio >= {header['goal']:g} with the same R-curve.", "",
          "| case | baseline core-s | new core-s | **ratio** | fewer steps | cheaper step | levers | at phi = 1 "
-         "(bound) | held by the ringing (decay / a) | steps (baseline / new) | DOF | R mean over (0, hi] d: reference / new (diff) | R_init diff | "
+         "(bound) | held by the ringing (decay / a) | steps (baseline / new) | DOF | R mean over (0, hi] d: "
+         "reference / new (diff) | R_init diff | "
          "broken rods (reference / new) | L2 | same R-curve | baseline's R mean (diff) | verdict |",
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     L += [table_line(r) for r in rows]
@@ -363,7 +365,8 @@ def table_line(r: dict) -> str:
         return f"| {r['case']} |" + " |" * 16 + f" {r['verdict']} |"
     dof = f"{r['new_dof']}" if r["new_dof"] == r["baseline_dof"] else f"{r['baseline_dof']} / {r['new_dof']}"
     return (f"| {r['case']} | {r['baseline_core_s']:.0f} | {r['new_core_s']:.0f} | **{r['ratio']:.2f}** | "
-            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {unit_rate_cell(r)} | {ringing_cell(r)} | "
+            f"{r['fewer_steps']:.2f} | {r['cheaper_step']:.2f} | {r['lever_ratio']:.2f} | {unit_rate_cell(r)} | "
+            f"{ringing_cell(r)} | "
             f"{r['baseline_steps']} / "
             f"{r['new_steps']} | {dof} | hi {fmt(r.get('range_hi'), '.1f')}: {fmt(r.get('R_mean_reference'), '.4g')} "
             f"/ {fmt(r.get('R_mean_new'), '.4g')} ({pct(r.get('R_mean_rel'))}) | {pct(r.get('R_init_rel'))} | "

@@ -66,8 +66,8 @@ STUDY4 = {"s4_margin8_h20_qs": margin(8, 20), "s4_margin4_h10_qs": margin(4, 10)
 # against the same references; run order rho 0.04 (both cases), then rho 0.02
 STUDY5 = {f"s5_margin4_h10_qs_rho{tag}": {**margin(4, 10), "rate_adapt_rho_high": rho}
           for tag, rho in (("04", 0.04), ("02", 0.02))}
-# README.md, Study 6: the Rayleigh damping ratio zeta (which sets how fast a burst's ringing decays), at phi = 1 (its own
-# effect) and with study 4's choice; stage A at reduced against s6_phi1 (zeta 0.2, this build), in this order
+# README.md, Study 6: the Rayleigh damping ratio zeta (which sets how fast a burst's ringing decays), at phi = 1
+# (its own effect) and with study 4's choice; stage A at reduced against s6_phi1 (zeta 0.2, this build), in this order
 STUDY6 = {"s6_phi1": {"rate_adapt_max": 1}, "s6_phi1_z05": {"rate_adapt_max": 1, "zeta": 0.5},
           "s6_phi1_z10": {"rate_adapt_max": 1, "zeta": 1.0}, "s6_m4": margin(4, 10),
           "s6_m4_z05": {**margin(4, 10), "zeta": 0.5}, "s6_m4_z10": {**margin(4, 10), "zeta": 1.0}}
@@ -411,8 +411,8 @@ def report6(preset: str = "reduced") -> str:
             ref = json.loads((TIP_DATA / f"s80_G9_cut_p{keys['crisscross_phase']:g}.json").read_text())
             stage_d.append(judged_row("converged", CASES[0], name, json.loads(own.read_text()), ref))
     if stage_d:
-        out += "\nStage D (theta30's phases 1/2 and 3/4, phi = 1, zeta 0.5 against research/tip's stage 7 runs):\n\n" + \
-            "\n".join(judged_table(stage_d)) + "\n\n" + decision6d(stage_d) + "\n"
+        out += ("\nStage D (theta30's phases 1/2 and 3/4, phi = 1, zeta 0.5 against research/tip's stage 7 "
+                "runs):\n\n" + "\n".join(judged_table(stage_d)) + "\n\n" + decision6d(stage_d) + "\n")
     stage_c = rows4(("s6_phi1_z05",))
     if stage_c:   # README.md, Study 6, stage C: the damping's own effect at converged, against the records
         out += "\nStage C (phi = 1, zeta 0.5 against the converged records at zeta 0.2):\n\n" + \
