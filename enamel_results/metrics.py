@@ -102,9 +102,11 @@ class Comparison:
 
 def same_rcurve(a: RCurve, b: RCurve, tol: float, lo: float = RANGE_OVER_D[0],
                 hi: float = RANGE_OVER_D[1]) -> Comparison:
-    """"The same R-curve": over the common range of (lo, hi] (at least MIN_RANGE_OVER_D), R averaged over crack
-    advance and R_init (the first point) within `tol` (relative to a), and the broken rod elements over the range
-    within ROD_REL_TOL (or ROD_ABS_TOL elements)."""
+    """"The same R-curve" for single configurations: over the common range of (lo, hi] (at least
+    MIN_RANGE_OVER_D), R averaged over crack advance and R_init (the first point) within `tol` (relative to a), and
+    the broken rod elements over the range within ROD_REL_TOL (or ROD_ABS_TOL elements). Whether two settings give
+    the same R-curve a single configuration never decides (its curve moves with the tip's phase in the lattice):
+    paired_phase_comparison does, over phases; this comparison is shown beside it."""
     top = min(hi, float(a.da[-1]), float(b.da[-1]))
     comparable = top - lo >= MIN_RANGE_OVER_D - 1e-9
     ma, mb = advance_mean(a, lo, top), advance_mean(b, lo, top)
@@ -128,9 +130,10 @@ PHASE_GRID_STEP_OVER_D = 0.1
 
 @dataclasses.dataclass(frozen=True)
 class PhaseAverage:
-    """R at equal crack advance over the phases: `curve` the mean (an RCurve, judged by same_rcurve like any
-    other; its broken_rods the phases' mean count up to the grid's end, rounded), `low`/`high` the smallest and
-    largest phase at each grid point, `each` every phase's R on the grid."""
+    """R at equal crack advance over the phases: `curve` the mean (an RCurve; its broken_rods the phases' mean
+    count up to the grid's end, rounded), `low`/`high` the smallest and largest phase at each grid point, `each`
+    every phase's R on the grid. Two settings are compared phase by phase (paired_phase_comparison), not by their
+    averages alone."""
     curve: RCurve
     low: np.ndarray
     high: np.ndarray
@@ -152,3 +155,73 @@ def phase_average(curves: list[RCurve], step: float = PHASE_GRID_STEP_OVER_D) ->
     mean_rods = None if any(r is None for r in rods) else int(round(sum(rods) / len(rods)))
     return PhaseAverage(RCurve.of(grid, each.mean(axis=0), broken_rods=mean_rods), each.min(axis=0),
                         each.max(axis=0), each)
+
+
+# --- "The same R-curve" between two settings: paired over the phases ---------------------------------------------
+# Phase k under setting A and under setting B share where the tip sits in the lattice, so their difference is the
+# setting's effect at that phase; the phases' differences, averaged with their standard error, decide.
+
+
+@dataclasses.dataclass(frozen=True)
+class PairedDifference:
+    """One quantity's relative differences (B - A) / A over the pairs: `each` per phase, `mean` their mean d, `se`
+    its standard error (sample std, ddof=1, over sqrt(N)), `low`/`high` the smallest and largest, and `same`:
+    |d| <= tol and |d| <= 2 se."""
+    each: tuple
+    mean: float
+    se: float
+    low: float
+    high: float
+    same: bool
+
+
+@dataclasses.dataclass(frozen=True)
+class PairedComparison:
+    """Setting B against reference A, phase by phase (paired_phase_comparison); `same` decides."""
+    tol: float
+    lo: float
+    hi: tuple               # each pair's common range is (lo, hi[k]]
+    comparable: bool        # hi[k] - lo >= MIN_RANGE_OVER_D for every pair
+    means_a: tuple          # each phase's R averaged over its pair's common range, A and B
+    means_b: tuple
+    mean_a: float           # the phase-averaged means: the mean of means_a, of means_b
+    mean_b: float
+    inits_a: tuple          # each phase's R_init (the first point), A and B
+    inits_b: tuple
+    level: PairedDifference     # of the mean over the common range
+    init: PairedDifference      # of R_init (the first point)
+    singles: tuple          # each pair by same_rcurve: shown beside, never deciding
+    same: bool
+
+
+def paired_difference(each: list[float], tol: float) -> PairedDifference:
+    x = np.asarray(each, dtype=float)
+    d, se = float(x.mean()), float(x.std(ddof=1) / math.sqrt(x.size))
+    return PairedDifference(tuple(float(v) for v in x), d, se, float(x.min()), float(x.max()),
+                            bool(abs(d) <= tol and abs(d) <= 2 * se))
+
+
+def paired_phase_comparison(a: list[RCurve], b: list[RCurve], tol: float, lo: float = RANGE_OVER_D[0],
+                            hi: float = RANGE_OVER_D[1]) -> PairedComparison:
+    """"The same R-curve" between two settings: a[k] and b[k] are phase k under setting A (the reference) and B.
+    Per pair, as same_rcurve computes them over the pair's common range of (lo, hi]: the relative difference of R
+    averaged over crack advance, and of R_init (the first point), both relative to A's. For each of the two
+    quantities, with d the mean of the N pairs' differences and SE = std(ddof=1) / sqrt(N):
+
+        |d| <= tol  and  |d| <= 2 SE      (within the tolerance, and not a significant difference)
+
+    B is the same R-curve as A when both quantities pass and every pair's common range is at least
+    MIN_RANGE_OVER_D. ValueError for lists of unequal length or fewer than 2 pairs."""
+    if len(a) != len(b):
+        raise ValueError(f"paired phases need as many curves under each setting ({len(a)} and {len(b)})")
+    if len(a) < 2:
+        raise ValueError("a paired phase comparison needs at least 2 pairs")
+    singles = tuple(same_rcurve(ca, cb, tol, lo, hi) for ca, cb in zip(a, b))
+    level = paired_difference([c.mean_rel for c in singles], tol)
+    init = paired_difference([c.init_rel for c in singles], tol)
+    comparable = all(c.comparable for c in singles)
+    means_a, means_b = tuple(c.mean_a for c in singles), tuple(c.mean_b for c in singles)
+    return PairedComparison(tol, lo, tuple(c.hi for c in singles), comparable, means_a, means_b,
+                            float(np.mean(means_a)), float(np.mean(means_b)), tuple(float(c.R[0]) for c in a),
+                            tuple(float(c.R[0]) for c in b), level, init, singles,
+                            bool(comparable and level.same and init.same))

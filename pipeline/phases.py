@@ -4,6 +4,7 @@ R-curve (docs/results.md, "Phase-averaged R-curves").
     python3 -m pipeline.phases paper_cases/theta30_s21.4_e10_cv0.toml --preset converged --phases 4 --jobs 2
     python3 -m pipeline.phases CASE.toml --preset ci --phases 4 --set Gamma_k_over_sigma0sq=8
     python3 -m pipeline.phases CASE.toml --preset ci --phases 4 --report-only
+    python3 -m pipeline.phases CASE.toml --preset converged --phases 4 --compare rate_factor=0.5 [--tol 0.10]
 
 Phase k of N runs the case with `crisscross_phase = k/N` (the tip's place in the crisscross lattice, in units of
 the crisscross spacing d/sin(theta_D): docs/model.md) into RUNS/<preset>/<case>[__<sets>]/phase_<k>of<N>/. The
@@ -12,6 +13,12 @@ solver's --resume). The report goes next to the runs: phase_average.md (each pha
 break, and the average with its spread), phase_average.csv (R at equal crack advance: mean, low, high and each
 phase) and phase_average.png. Exit status 0 when every phase completed, 1 otherwise (the report then covers the
 phases that completed, and says which did not).
+
+Comparing two settings (docs/results.md, "Phase-averaged R-curves"): --compare KEY=VALUE (repeatable) runs the same
+N phases with those overrides on top of the --set ones as setting B, beside the plain setting A, and writes
+compare.md next to B's runs: each phase's pair (A, B) and the paired verdict of
+enamel_results.metrics.paired_phase_comparison at --tol (default metrics.TOL_RATE_SPEED, 2 %; 0.10 for size and
+mesh). Its last line, the verdict, is printed too. With --report-only the comparison reads the runs there are.
 """
 from __future__ import annotations
 
@@ -61,11 +68,13 @@ def run_phase(args: list[str], out: pathlib.Path) -> int:
         return subprocess.run(args, stdout=subprocess.DEVNULL, stderr=log).returncode
 
 
-def run_all(binary, case, preset, sets, n, root, jobs) -> dict[int, int]:
+def run_all(binary, case, preset, settings: list[tuple[list[str], pathlib.Path]], n, jobs) -> dict:
+    """Every phase of every setting (its --set overrides, its run root), `jobs` at once: {(root, k): status}."""
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {k: pool.submit(run_phase, solver_args(binary, case, preset, sets, k, n, phase_dir(root, k, n)),
-                                  phase_dir(root, k, n)) for k in range(n)}
-        return {k: f.result() for k, f in futures.items()}
+        futures = {(root, k): pool.submit(run_phase, solver_args(binary, case, preset, sets, k, n,
+                                                                 phase_dir(root, k, n)), phase_dir(root, k, n))
+                   for sets, root in settings for k in range(n)}
+        return {key: f.result() for key, f in futures.items()}
 
 
 def load_phases(root: pathlib.Path, n: int) -> dict[int, results.Result]:
@@ -164,6 +173,73 @@ def report(root: pathlib.Path, case: pathlib.Path, preset: str, sets: list[str],
     return text
 
 
+def pct(x: float) -> str:
+    return "-" if math.isnan(x) else f"{x:+.2%}"
+
+
+def verdict_line(p: metrics.PairedComparison | None, extra: list[str], pairs: int) -> str:
+    """The paired verdict in one line: B (the --compare overrides) against A."""
+    b = " ".join(extra)
+    if p is None:
+        return f"verdict: none for {b}: {pairs} phase(s) completed under both settings, at least 2 needed"
+    why = [f"{label} {q.mean:+.2%} beyond {p.tol * 100:g}%" for label, q in (("mean R", p.level), ("R_init", p.init))
+           if abs(q.mean) > p.tol]
+    why += [f"{label} {q.mean:+.2%} beyond 2 SE = {2 * q.se:.2%}" for label, q in
+            (("mean R", p.level), ("R_init", p.init)) if abs(q.mean) > 2 * q.se]
+    why += [] if p.comparable else [f"not comparable (a common range under {metrics.MIN_RANGE_OVER_D:g} d)"]
+    head = "the same R-curve" if p.same else "NOT the same R-curve"
+    return (f"verdict: {b} is {head} as the plain setting at {p.tol * 100:g}%, paired over {pairs} phases (mean R "
+            f"{p.level.mean:+.2%} +- {p.level.se:.2%}, R_init {p.init.mean:+.2%} +- {p.init.se:.2%})"
+            + (f": {'; '.join(why)}" if why else ""))
+
+
+def compare_rows(p: metrics.PairedComparison, ks: list[int], n: int) -> list[str]:
+    lines = ["", "| phase | A mean R | B mean R | diff | A R_init | B R_init | R_init diff | common range (d) | "
+             "alone (same_rcurve, not deciding) |", "|---|---|---|---|---|---|---|---|---|"]
+    for j, k in enumerate(ks):
+        c = p.singles[j]
+        lines.append(f"| {k}/{n} | {c.mean_a:.3f} | {c.mean_b:.3f} | {pct(c.mean_rel)} | "
+                     f"{p.inits_a[j]:.3f} | {p.inits_b[j]:.3f} | {pct(c.init_rel)} | "
+                     f"({p.lo:g}, {c.hi:.2f}] | {'same' if c.same else 'not the same'} |")
+    lines += ["", "| quantity | mean d | SE | band (min to max) | within tol | not significant (abs(d) <= 2 SE) |",
+              "|---|---|---|---|---|---|"]
+    for label, q in (("mean R", p.level), ("R_init", p.init)):
+        lines.append(f"| {label} | {pct(q.mean)} | {q.se:.2%} | {pct(q.low)} to {pct(q.high)} | "
+                     f"{abs(q.mean) <= p.tol} | {abs(q.mean) <= 2 * q.se} |")
+    lines.append(f"\nPhase-averaged mean R: A {p.mean_a:.3f}, B {p.mean_b:.3f}.")
+    return lines
+
+
+def compare_report(root_a: pathlib.Path, root_b: pathlib.Path, case: pathlib.Path, preset: str, sets: list[str],
+                   extra: list[str], n: int, tol: float) -> str:
+    """compare.md in root_b: setting B (sets + extra) against A (sets), paired phase by phase over the phases
+    completed under both. Returns its text, whose last line is the verdict."""
+    done_a, done_b = load_phases(root_a, n), load_phases(root_b, n)
+    ks = sorted(set(done_a) & set(done_b))
+    curves = lambda done: [metrics.rcurve_of(done[k]) for k in ks]  # noqa: E731
+    p = metrics.paired_phase_comparison(curves(done_a), curves(done_b), tol) if len(ks) >= 2 else None
+    a_sets = " ".join(f"--set {s}" for s in sets) or "the case as it is"
+    lines = [f"# {case.stem}: {' '.join(extra)} against the plain setting ({n} phases, preset {preset})", "",
+             f"Written by `python3 -m pipeline.phases --compare`: setting A ({root_a.name}) runs {a_sets}, setting B "
+             f"(the runs next to this file) A with {' '.join('--set ' + s for s in extra)}; phase k runs "
+             f"`{PHASE_KEY} = k/{n}` under both.",
+             "Rule (enamel_results.metrics.paired_phase_comparison): per phase, the relative difference (B - A) / A "
+             "of R averaged over crack advance over the pair's common range of (0, 30] d and of R_init; for each, "
+             f"the mean d over the pairs within the tolerance {tol * 100:g}% and within twice its standard error "
+             f"(sample std over sqrt(N)); every common range at least {metrics.MIN_RANGE_OVER_D:g} d; at least 2 "
+             "pairs."]
+    if p is not None:
+        lines += compare_rows(p, ks, n)
+    missing = [k for k in range(n) if k not in ks]
+    if missing:
+        lines.append(f"\n**Not completed under both settings**: phase(s) {', '.join(f'{k}/{n}' for k in missing)};"
+                     " the pairs are the others.")
+    lines += ["", verdict_line(p, extra, len(ks))]
+    text = "\n".join(lines) + "\n"
+    (root_b / "compare.md").write_text(text)
+    return text
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m pipeline.phases", description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -177,22 +253,47 @@ def main(argv=None) -> int:
     ap.add_argument("--binary", default=os.environ.get("ENAMEL_BINARY", str(paths.SOLVER)),
                     help="the solver (default $ENAMEL_BINARY, else build/enamel-dem)")
     ap.add_argument("--report-only", action="store_true", help="no runs: the report from the runs there are")
+    ap.add_argument("--compare", dest="compares", action="append", default=[], metavar="KEY=VALUE",
+                    help="setting B: these overrides on top of --set, run beside the plain setting A and compared "
+                         "with it phase by phase into compare.md (repeatable)")
+    ap.add_argument("--tol", type=float, default=metrics.TOL_RATE_SPEED,
+                    help=f"the comparison's tolerance (default {metrics.TOL_RATE_SPEED:g}; 0.10 for size and mesh)")
     a = ap.parse_args(argv)
+    check_args(ap, a)
+    root = run_root(a.runs, a.preset, a.case, a.sets)
+    settings = [(a.sets, root)]
+    if a.compares:
+        settings.append((a.sets + a.compares, run_root(a.runs, a.preset, a.case, a.sets + a.compares)))
+    status = {} if a.report_only else run_all(a.binary, a.case, a.preset, settings, a.phases, a.jobs)
+    for _, r in settings:
+        r.mkdir(parents=True, exist_ok=True)
+    texts = [report(r, a.case, a.preset, sets, a.phases) for sets, r in settings]
+    print(compare_report(root, settings[1][1], a.case, a.preset, a.sets, a.compares, a.phases, a.tol)
+          if a.compares else texts[0], end="")
+    failed = [key for key, rc in status.items() if rc != 0]
+    for r, k in failed:
+        print(f"phases: phase {k}/{a.phases} of {r.name} exited with status {status[(r, k)]} "
+              f"(log: {phase_dir(r, k, a.phases) / 'log.txt'})", file=sys.stderr)
+    incomplete = any(len(load_phases(r, a.phases)) < a.phases for _, r in settings)
+    return 1 if failed or incomplete else 0
+
+
+def check_args(ap: argparse.ArgumentParser, a) -> None:
+    """Refuse what the phases cannot run: argparse's exit 2 with the reason."""
     if not 2 <= a.phases <= 64:
         ap.error(f"--phases = {a.phases}: allowed range [2, 64]")
-    if any(s.split("=", 1)[0].strip() == PHASE_KEY for s in a.sets):
-        ap.error(f"--set {PHASE_KEY}=...: the phases set it; give --phases instead")
+    keys = lambda sets: {s.split("=", 1)[0].strip() for s in sets}  # noqa: E731
+    if PHASE_KEY in keys(a.sets) | keys(a.compares):
+        ap.error(f"--set/--compare {PHASE_KEY}=...: the phases set it; give --phases instead")
+    if keys(a.sets) & keys(a.compares):
+        ap.error(f"--compare {', '.join(sorted(keys(a.sets) & keys(a.compares)))}: already given by --set (setting "
+                 "A); B is A with the --compare overrides")
+    if any("=" not in s for s in a.compares):
+        ap.error("--compare takes KEY=VALUE")
+    if not a.tol > 0:
+        ap.error(f"--tol = {a.tol}: a positive fraction (0.02 is 2 %)")
     if not a.case.is_file():
         ap.error(f"case file {a.case} not found")
-    root = run_root(a.runs, a.preset, a.case, a.sets)
-    status = {} if a.report_only else run_all(a.binary, a.case, a.preset, a.sets, a.phases, root, a.jobs)
-    root.mkdir(parents=True, exist_ok=True)
-    print(report(root, a.case, a.preset, a.sets, a.phases), end="")
-    failed = [k for k, rc in status.items() if rc != 0]
-    for k in failed:
-        print(f"phases: phase {k}/{a.phases} exited with status {status[k]} "
-              f"(log: {phase_dir(root, k, a.phases) / 'log.txt'})", file=sys.stderr)
-    return 1 if failed or len(load_phases(root, a.phases)) < a.phases else 0
 
 
 if __name__ == "__main__":

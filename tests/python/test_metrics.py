@@ -78,3 +78,65 @@ def test_a_run_that_stopped_early_is_compared_over_the_common_range_or_not_at_al
     tiny = sawtooth(da=DA[DA <= 6])
     c = metrics.same_rcurve(a, tiny, 0.1)
     assert not c.comparable and not c.same
+
+
+# --- Between two settings: paired over the phases (metrics.paired_phase_comparison) -----------------------------
+
+def phases_of(n=4):
+    """One configuration per phase: the teeth shifted by k/n of a period, the level moving with the phase."""
+    return [sawtooth(shift=k * PERIOD / n, level=7.0 + 0.3 * k) for k in range(n)]
+
+
+def scaled(curves, factors):
+    return [metrics.RCurve.of(c.da, c.R * f, c.rod_da) for c, f in zip(curves, factors)]
+
+
+def test_paired_identical_settings_are_the_same():
+    a = phases_of()
+    p = metrics.paired_phase_comparison(a, phases_of(), metrics.TOL_RATE_SPEED)
+    assert p.same and p.comparable
+    assert p.level.mean == 0 and p.level.se == 0 and p.init.mean == 0
+    assert p.mean_a == pytest.approx(np.mean([metrics.advance_mean(c, 0, 30) for c in a]))
+    assert p.hi == pytest.approx([30.0] * 4)
+
+
+def test_paired_constant_5_percent_shift_differs():
+    a = phases_of()
+    p = metrics.paired_phase_comparison(a, scaled(a, [1.05] * 4), metrics.TOL_RATE_SPEED)
+    assert not p.same and not p.level.same and not p.init.same
+    assert p.level.each == pytest.approx([0.05] * 4) and p.level.mean == pytest.approx(0.05)
+    assert p.mean_b == pytest.approx(1.05 * p.mean_a)
+
+
+def test_paired_1_percent_shift_within_a_large_scatter_is_the_same():
+    """Phases whose own differences scatter by +-4 %: d = +1 % is within 2 % and within 2 SE (about 4 %), so the
+    same, while two of the single configurations alone would say not."""
+    a = phases_of()
+    each = [0.05, -0.03, 0.035, -0.015]
+    p = metrics.paired_phase_comparison(a, scaled(a, [1 + e for e in each]), metrics.TOL_RATE_SPEED)
+    assert p.level.mean == pytest.approx(0.01) and p.level.se == pytest.approx(np.std(each, ddof=1) / 2)
+    assert (p.level.low, p.level.high) == pytest.approx((-0.03, 0.05))
+    assert p.same
+    assert [s.same for s in p.singles] == [False, False, False, True]
+
+
+def test_paired_1_percent_shift_with_tiny_scatter_differs_by_the_two_se_rule():
+    """d = +1 % is within the 2 % tolerance, but the phases agree on it to 0.1 %: a significant difference, so not
+    the same, while every single configuration alone is within 2 %."""
+    a = phases_of()
+    each = [0.011, 0.009, 0.0105, 0.0095]
+    p = metrics.paired_phase_comparison(a, scaled(a, [1 + e for e in each]), metrics.TOL_RATE_SPEED)
+    assert abs(p.level.mean) <= p.tol and abs(p.level.mean) > 2 * p.level.se
+    assert not p.level.same and not p.same
+    assert all(s.same for s in p.singles)
+
+
+def test_paired_needs_two_pairs_of_equal_lists_and_comparable_ranges():
+    a = phases_of()
+    with pytest.raises(ValueError, match="as many"):
+        metrics.paired_phase_comparison(a, a[:3], 0.1)
+    with pytest.raises(ValueError, match="at least 2"):
+        metrics.paired_phase_comparison(a[:1], a[:1], 0.1)
+    short = [a[0], sawtooth(da=DA[DA <= 6]), a[2], a[3]]
+    p = metrics.paired_phase_comparison(a, short, 0.1)
+    assert not p.comparable and not p.same and p.level.same
