@@ -180,9 +180,12 @@ enum class Need { required, optional };
     X(integrator, Choice, numerics, optional, IntegratorScheme::paper, "[]", 0, 0, "-",                             \
       "integrator: paper = Newmark beta 0, consistent mass, H = M + dt/2 C factorised (reference); "                \
       "lumped = explicit, lumped mass")                                                                             \
+    X(rod_damping, Choice, numerics, optional, RodDamping::implicit, "[]", 0, 0, "-",                              \
+      "rods' stiffness damping (integrator lumped): implicit = the full b K of the rods, solved rod by rod "        \
+      "at each step (the paper's model); capped = explicit, b' = min(b, damping_cap / omega_max)")                  \
     X(damping_cap, Real, numerics, optional, 1, "(]", 0, 2, "-",                                                    \
-      "stiffness damping cap (integrator lumped): b' = min(b, damping_cap / omega_max), i.e. the "                  \
-      "stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "           \
+      "stiffness damping cap (integrator lumped, rod_damping capped): b' = min(b, damping_cap / omega_max), i.e. "  \
+      "the stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "       \
       "the stable step")                                                                                            \
     X(linear_solver, Choice, numerics, optional, LinearSolver::cholmod, "[]", 0, 0, "-",                            \
       "linear solver: for H = M + dt/2 C (integrator paper): CHOLMOD Cholesky or UMFPACK LU")                       \

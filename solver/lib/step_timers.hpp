@@ -19,6 +19,7 @@ enum class StepPhase : int {
   SliceNodes,
   SliceWrites,
   SliceBarrier,
+  RodDamping,
   GripsAndWork,
   ClockAndGrips,
   // paper (integrators/newmark.cpp)
@@ -62,6 +63,8 @@ inline constexpr std::array<StepPhaseInfo, kStepPhaseCount> kStepPhases = {{
      "per slice, mean over the threads: SliceOutputs, v_{n+1/2} and q_{n+1} written over the old values (the waiting slices after the "
      "barrier)"},
     {StepPhase::SliceBarrier, "barrier", 2, "mean over the threads: waiting for the other threads at the pass's barrier"},
+    {StepPhase::RodDamping, "rod damping", 1,
+     "solveRodDampingOfStep (rod_damping implicit): the rods' s M + dt b K solved, q corrected, the slices' sums"},
     {StepPhase::GripsAndWork, "grips and work", 1,
      "computeReactions, addWorkOfGrips, addDampingWork: the grips' reactions and work, the damping work"},
     {StepPhase::ClockAndGrips, "clock and grips", 1,

@@ -95,7 +95,7 @@ TEST(StepTimers, TimedStepsAreTheStepsAndTimeTheirSchemesPhases) {
   using P = StepPhase;
   const std::vector<P> common = {P::Advance, P::InterfaceDissipation, P::DeletionCheck, P::Deletions, P::CrackMeasure};
   const std::vector<P> lumped = {P::InterfaceSchedule, P::SlicePass, P::SliceInterfaces, P::SliceNodes,
-                                 P::SliceWrites, P::SliceBarrier, P::GripsAndWork, P::ClockAndGrips};
+                                 P::SliceWrites, P::SliceBarrier, P::RodDamping, P::GripsAndWork, P::ClockAndGrips};
   const std::vector<P> paper = {P::PaperPositions, P::PaperBoundaryConditions, P::PaperInterfaces, P::PaperRodForces,
                                 P::PaperAccelerations, P::PaperVelocities, P::PaperReactions};
   const int steps = 30;

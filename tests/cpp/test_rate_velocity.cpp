@@ -69,11 +69,13 @@ TEST(RateVelocity, QuasiStaticCorrectionLeavesTheMotionBeyondLoadingUnchangedByA
     EXPECT_EQ(keep.inelastic, 0);
     EXPECT_EQ(qs.inelastic, 0);
     EXPECT_EQ(keep.beyondBefore, qs.beyondBefore);  // the same run until phi changes
-    // keep: the grips run ahead of the interior, ~(4 - 1)^2 x the loading's motion at phi = 1 at the ramp's end
-    EXPECT_GT(keep.beyondAfter, 2.0 * keep.quasiStaticKinetic);
+    // keep: the grips run ahead of the interior, up to ~(4 - 1)^2 x the loading's motion at phi = 1 at the ramp's
+    // end, less what the rods' damping b K takes meanwhile (measured 3.6 x with paper, 1.9 x with lumped, whose
+    // implicit b K damps the highest modes more than paper's trapezoid does)
+    EXPECT_GT(keep.beyondAfter, 1.5 * keep.quasiStaticKinetic);
     // quasi_static: the ramp adds nothing beyond the loading's motion but what the faster loading itself drives
     // (the damping force of the motion phi (U'/U) q, so phi^2 = 16 x the level at phi = 1: measured 15.4 and
-    // 15.7 x on 2026-12-06), and far less than keep leaves
+    // 15.7 x), and far less than keep leaves
     EXPECT_LT(qs.beyondAfter, 1.5 * 16.0 * qs.beyondBefore);
     EXPECT_LT(qs.beyondAfter, 0.2 * keep.beyondAfter);
     EXPECT_LT(qs.worstBalance, std::max(2.0 * keep.worstBalance, 1e-9));

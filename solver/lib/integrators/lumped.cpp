@@ -15,6 +15,7 @@
 
 #include "kernels.hpp"
 #include "node_rows.hpp"
+#include "rod_damping.hpp"
 #include "schemes.hpp"
 #include "slice_outputs.hpp"
 #include "step_parts.hpp"
@@ -90,12 +91,14 @@ alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
 // Fast scheme `lumped` (ours, docs/solver.md): explicit central differences with a diagonal mass.
 //   M: lumped rod mass, translations rho A L / 2 per element end; rotations an isotropic rotary inertia
 //      alpha rho Ip L / 2 per element end, alpha the smallest scale at which rotations stop governing.
-//   C = a M + b' K with b' = min(b, c/omega_max), c = damping_cap (default 1: the stiffness part's damping
-//      ratio at omega_max is at most 1/2; an explicit stiffness damping above that would need a far smaller
-//      step, and a lower cap allows a larger one).
+//   C = a M + b K, the paper's Rayleigh damping. rod_damping = implicit (default): the rods' b K at v_{n+1/2},
+//      solved rod by rod (rod_damping.hpp: s M + dt b K is block tridiagonal along each rod), which no step
+//      size makes unstable. rod_damping = capped: b' K at v_{n-1/2}, explicit, b' = min(b, c/omega_max),
+//      c = damping_cap (the stiffness part's damping ratio at omega_max at most c/2).
 //   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
-//   2 / omega_max (sqrt(1 + xi^2) - xi), xi = b' omega_max / 2.
-// One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first:
+//   2 / omega_max (sqrt(1 + xi^2) - xi), xi = a / (2 omega_max) (+ b' omega_max / 2 when capped).
+// One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first (as written for capped;
+// implicit: b' = 0 in the pass, then solveRodDampingOfStep below):
 //   f_iface(q_n) = K_I q_n + f_corr, K q_n, K v_{n-1/2}  (forces for interfaces, for beams: every interface's
 //                                                          elastic force is linear, K_I q_n (K_I: the elastic
 //                                                          interfaces' stiffness, elasticInterfaceBlocks); the
@@ -111,6 +114,11 @@ alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
 //                                                          against the damping force, its stiffness part
 //                                                          as applied, at the lagged velocity)
 //   q_{n+1} = q_n + dt v_{n+1/2};  q of the grips = shape U(t_{n+1})   (positions, boundary condition)
+// rod_damping = implicit: the pass gives v* (b' = 0) and leaves q_n in place; then
+//   (s M + dt b K) v_{n+1/2} = s M v*  (free rows; s = 1 + a dt/2; the grips' v given)   (rods' damping)
+//   q_{n+1} = q_n + dt v_{n+1/2}
+//   R_p += b (K v_{n+1/2})_p;  W_damp += dt v_{n+1/2} . (a M v_{n+1/2} + b K v_{n+1/2}), where on a free row
+//   dt b (K v_{n+1/2})_f = s m_f (v*_f - v_{n+1/2,f})
 class LumpedIntegrator : public Integrator {
  public:
   LumpedIntegrator(const CaseParams& p, const Model& m, const Materials& mat, const Operators& ops)
@@ -145,9 +153,10 @@ class LumpedIntegrator : public Integrator {
     rows_.gripResidual = VecX::Zero(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
     for (double shape : ops.prescribedShape) largestShape_ = std::max(largestShape_, std::abs(shape));
     omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
-    bEff_ = std::min(mat.dampB, p.damping_cap / omegaMax_);
+    implicit_ = p.rod_damping == RodDamping::implicit;
+    bEff_ = implicit_ ? mat.dampB : std::min(mat.dampB, p.damping_cap / omegaMax_);
     dt_ = p.dt_factor * 2.0 * M_PI / omegaMax_;
-    const double xi = 0.5 * bEff_ * omegaMax_ + 0.5 * mat.dampA / omegaMax_;
+    const double xi = (implicit_ ? 0.0 : 0.5 * bEff_ * omegaMax_) + 0.5 * mat.dampA / omegaMax_;
     const double limit = 2.0 / omegaMax_ * (std::sqrt(1.0 + xi * xi) - xi);
     if (dt_ > 0.95 * limit) {
       std::ostringstream msg;
@@ -156,6 +165,16 @@ class LumpedIntegrator : public Integrator {
           << limit << " (omega_max = " << omegaMax_ << ", damping ratio there " << xi
           << "): use dt_factor <= " << 0.95 * limit * omegaMax_ / (2 * M_PI);
       throw IntegratorError(msg.str());
+    }
+    if (implicit_) {
+#if defined(_OPENMP)
+      const int lanes = omp_get_max_threads();
+#else
+      const int lanes = 1;
+#endif
+      sliceOfNode_ = m.nodeSlice;
+      rodSolve_ = factoriseRodDamping(ops.K, mass_, ops.prescribedDofs, m.nodeRod, 1.0 + 0.5 * dampA_ * dt_,
+                                      dt_ * bEff_, lanes);
     }
   }
 
@@ -167,7 +186,9 @@ class LumpedIntegrator : public Integrator {
   std::string describe() const override {
     std::ostringstream o;
     o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
-      << ", stiffness damping b' " << bEff_ << ", " << rows_.K.values.size() / 36
+      << (implicit_ ? ", stiffness damping b K implicit rod by rod, b " : ", stiffness damping capped, b' ") << bEff_
+      << (implicit_ ? " (" + std::to_string(rodSolve_.factors.size()) + " distinct node factors)" : std::string())
+      << ", " << rows_.K.values.size() / 36
       << " distinct 6x6 stiffness blocks" << (rows_.K.split.empty() ? "" : " (in-plane and out-of-plane DOFs uncoupled: 18 entries each)")
       << ", elastic interfaces in " << rows_.KI.values.size() / 36 << " distinct 6x6 blocks (18 entries each), node rows "
       << nodeRowsTarget(rows_);
@@ -183,6 +204,8 @@ class LumpedIntegrator : public Integrator {
     laps.lap(StepPhase::InterfaceSchedule);
     s.failedInterfaces = computeForcesAndAdvanceVelocities(m, mat, ops, s);
     laps.lap(StepPhase::SlicePass);
+    if (implicit_) solveRodDampingOfStep(ops, s);
+    laps.lap(StepPhase::RodDamping);
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
     addDampingWork(s);
@@ -212,6 +235,7 @@ class LumpedIntegrator : public Integrator {
 
   void updateOperators(const Operators& ops) override {  // the lumped mass stays; only K changed
     rows_.K = toNodeBlocks(SpMatRow(ops.K));
+    if (implicit_) refactoriseRodDamping(ops.K, mass_, ops.prescribedDofs, rodSolve_);
   }
 
   double kineticEnergy(const Operators&, const State& s) const override {
@@ -253,7 +277,8 @@ class LumpedIntegrator : public Integrator {
     step.keep = 1.0 - 0.5 * dampA_ * dt_;
     step.scale = 1.0 + 0.5 * dampA_ * dt_;
     step.dt = dt_;
-    step.b = bEff_;
+    step.b = implicit_ ? 0.0 : bEff_;
+    step.move = implicit_ ? 0.0 : dt_;
     step.Vgrip = computeGripVelocity(mat.loading, s, 0.5 * dt_, dt_);
     vNext_.resize(s.vHalf.size());
     qNext_.resize(s.q.size());
@@ -306,6 +331,34 @@ class LumpedIntegrator : public Integrator {
     addShareOfTimers(mine, share, *timers_);
   }
 
+  // The rods' damping, implicit (the class comment): v_{n+1/2} from the pass's v* (the pass left q_n in place),
+  // q_{n+1} = q_n + dt v_{n+1/2}, and the slices' sums again: max |dt v|, max |q|, v.Mv and v.Kv (on a free row
+  // from the solve's identity, on a grip's from its row of K); the grips' b K v into their residuals.
+  void solveRodDampingOfStep(const Operators& ops, State& s) {
+    vStar_ = s.vHalf;
+    solveRodDamping(rodSolve_, s.vHalf);
+    multiplyGripRows(rodSolve_, s.vHalf, KvGrip_);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) rows_.gripResidual[i] += bEff_ * KvGrip_[i];
+    const int slices = static_cast<int>(sliceSums_.size());
+    const double cInv = 1.0 / rodSolve_.c;
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < slices; ++k) {
+      double largestStep = 0, largest = 0, workM = 0, workK = 0;
+      for (int dof = 6 * ops.sliceNodeStart[k]; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) {
+        const double v = s.vHalf[dof], step = dt_ * v;
+        s.q[dof] += step;
+        largestStep = std::max(largestStep, std::abs(step)), largest = std::max(largest, std::abs(s.q[dof]));
+        workM += v * mass_[dof] * v;
+        if (rows_.gripOfDof[dof] < 0) workK += v * rodSolve_.rhsScale[dof] * (vStar_[dof] - v) * cInv;
+      }
+      SliceSums& sums = sliceSums_[k];
+      sums.largestStep = DoublePair{largestStep, 0}, sums.largestValue = DoublePair{largest, 0};
+      sums.workM = DoublePair{workM, 0}, sums.workK = DoublePair{workK, 0};
+    }
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i)  // the grips' v.Kv, to the slice of their node
+      sliceSums_[sliceOfNode_[ops.prescribedDofs[i] / 6]].workK[1] += s.vHalf[ops.prescribedDofs[i]] * KvGrip_[i];
+  }
+
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with
   // a_p = (v_{n+1/2} - v_{n-1/2}) / dt and v_p = (v_{n+1/2} + v_{n-1/2}) / 2 (kept in vGrip_)
   void computeReactions(const Operators& ops, State& s) {
@@ -353,6 +406,10 @@ class LumpedIntegrator : public Integrator {
   }
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
+  bool implicit_ = true;             // rod_damping = implicit: the rods' b K solved at each step
+  RodDampingSolve rodSolve_;         // its factors (rod_damping.hpp)
+  VecX vStar_, KvGrip_;              // the pass's v*, and the grips' rows of K v_{n+1/2}
+  std::vector<int> sliceOfNode_;     // per node: its slice
   double largestShape_ = 0;          // max |shape| of the prescribed DOFs
   double moveBound_ = INFINITY;      // lastStepMoveBound (infinite: q was set otherwise, the schedules start afresh)
   double largestValue_ = INFINITY;   // a bound on max |q_n|

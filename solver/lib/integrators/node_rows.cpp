@@ -64,7 +64,7 @@ namespace {
   for (int j = 0; j < 3; ++j) {
     vOut[j] = vn[j];
     sums.workM += vn[j] * (mass[j] * vn[j]), sums.workK += vn[j] * Kv[j];
-    const Pair stepj = Pair{c.dt, c.dt} * vn[j], y = qNode[j] + stepj;
+    const Pair stepj = Pair{c.move, c.move} * vn[j], y = qNode[j] + stepj;
     qOut[j] = y;
     sums.largestStep = absMax(sums.largestStep, stepj), sums.largestValue = absMax(sums.largestValue, y);
   }

@@ -14,6 +14,8 @@ namespace enamel {
 // The constants of a step's velocity update.
 struct NodeStep {
   double keep, scale, dt, b, Vgrip;  // 1 - a dt/2, 1 + a dt/2, dt, b', V(t_n + dt/2)
+  double move;                       // dt where the pass moves q (rod_damping capped); 0 where the rods' damping
+                                     // solve moves it after the pass (implicit: q_{n+1} = q_n there)
 };
 
 // A slice's share of the damping work's two sums, and of the position update's maxima (pairs).
