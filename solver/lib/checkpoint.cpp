@@ -16,16 +16,14 @@ namespace enamel {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'N', 'A', 'M', 'E', 'L', 'C', 'K'};
-constexpr std::uint32_t kVersion = 11;  // 2: the header carries the build fingerprint; 3: State holds vHalf
-                                       // and the reactions, frames the rod stress; 4: the loading clock and
-                                       // the record's static elastic start; 5: history rows hold the kinetic
-                                       // energy beyond the loading's motion; 6: ... and the inelastic zone's
-                                       // reach, the record its edge warning; 7: the static start
-                                       // records whether the model held a mechanism; 8: the record its
-                                       // far-field rod break warning; 9: a CRC-32 of every byte before it;
-                                       // 10: State's interface dissipation account (empty at beta = 1)
-                                       // ends the file (before the trailing magic); 11: the margin rule's
-                                       // progress and forecast (State::lastProgress, lastForecast) after it
+// The format's version: a checkpoint of any other is refused (readHeader); raise it whenever what a checkpoint
+// holds changes. This format holds, after the header (the build fingerprint and the effective case): State with
+// vHalf, the reactions, the loading clock, the interface dissipation account (empty at beta = 1) and the margin
+// rule's progress and forecast (State::lastProgress, lastForecast); the frames with the rod stress; history rows
+// with the kinetic energy beyond the loading's motion and the inelastic zone's reach; the record with the static
+// elastic start, whether the model held a mechanism, and the edge and far-field rod break warnings; then a
+// CRC-32 of every byte before it (transferFields gives the order).
+constexpr std::uint32_t kVersion = 11;
 // The file: magic, version, build, case, fields (transferFields), CRC-32 of all that (4 bytes), magic.
 constexpr std::size_t kTrailerBytes = sizeof(std::uint32_t) + sizeof kMagic;
 

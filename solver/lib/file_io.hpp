@@ -55,7 +55,7 @@ class DirectoryLock {
   std::string why_;
 };
 
-/// Who holds the lock of `dir`, as its lock file says ("pid 123 host node7 since 2026-12-06T03:20:00Z"), or
+/// Who holds the lock of `dir`, as its lock file says ("pid 123 host node7 since <start, UTC, ISO 8601>"), or
 /// "" when the file is absent or empty.
 std::string directoryLockHolder(const std::string& dir);
 

@@ -144,7 +144,7 @@ struct VoronoiCell {
 /// Edges shorter than this (d) are no interface: where a slice's plies are aligned (ply-1 and ply-2 rods at the
 /// same y, every d/(2 sin theta) along x) the section is a rectangular lattice whose Voronoi vertices join four
 /// cells, and round-off makes each diagonal an edge of length ~1e-9 or none; 1e-6 d drops them whatever the
-/// round-off (before 2026-12-06: 1e-9, and a hair of h_e changed the ci theta30 specimen's interfaces).
+/// round-off (at 1e-9 a hair of h_e changed the ci theta30 specimen's interfaces).
 constexpr double kMinVoronoiEdge = 1e-6;
 
 /// Voronoi tessellation of points (y, z) in the strip yLo <= y <= yHi, periodic in z with period `period`.

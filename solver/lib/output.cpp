@@ -109,8 +109,7 @@ const std::vector<HistoryColumn>& historyColumns() {
       {"energy_balance_error", &M::balanceError, "-",
        "(external work - stored - kinetic - dissipated) / max(|external work|, work_floor), work_floor = 0.1 "
        "Gamma_i B d (this dataset's attribute work_floor, in E_r d^3): meaningful from the first row, where the "
-       "work is ~1e-10 of the floor; the relative error of the balance once the work exceeds the floor "
-       "(before 2026-12-06: divided by the external work alone)"},
+       "work is ~1e-10 of the floor; the relative error of the balance once the work exceeds the floor"},
       {"broken_rod_elements", &M::brokenBeams, "count"},
       {"failed_interfaces", &M::failedInterfaces, "count"},
       {"inelastic_interfaces", &M::inelasticInterfaces, "count"},

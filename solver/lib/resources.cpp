@@ -12,7 +12,7 @@ namespace enamel {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-// Peak resident memory (VmHWM, /meta/peak_memory_mb) measured on 2026-12-02, theta30, 20 steps, 1 thread:
+// Peak resident memory (VmHWM, /meta/peak_memory_mb) measured on theta30, 20 steps, 1 thread:
 //   lumped  16 x 8 d: 748 nodes 32 MB;  40 x 20 d: 4640 nodes 59 MB;  80 x 80 d: 37136 nodes 270 MB;
 //           200 x 200 d (paper preset): 231k nodes 1630 MB            -> ~6.5-7 kB per node
 //   paper   40 x 20 d: 4640 nodes 65 MB;  40 x 40 d: 9284 nodes 120 MB -> 6.4 kB per node + ~52 B per node
@@ -44,15 +44,15 @@ ResourceEstimate estimateResources(const CaseParams& p) {
 }
 
 namespace {
-// Time of a run (estimateRunTime). Measured with the build of commit c09beab on 2026-12-06, one thread, on this
-// project's development machine (AMD EPYC, AVX-512; 2 cores under other builds and runs, load 10-16: wall times
-// swing, so rates are CPU (user) seconds, and the constants take the slow side), with
+// Time of a run (estimateRunTime). Measured one thread a run on this project's development machine (AMD EPYC,
+// AVX-512; 2 cores under other builds and runs, load 10-16: wall times swing, so rates are CPU (user) seconds, and
+// the constants take the slow side), with
 //   /usr/bin/time enamel-dem run paper_cases/CASE.toml --preset P --set threads=1 [--set max_steps=N ...]
 // and the run's /meta and /history.
 // Applied displacement at the stop, at delta0 = 0.1 d (in linear kinematics every displacement scales with delta0,
 // docs/model.md): U_end = U_i + k_a stop_da_over_d. U_i is where the crack starts to grow in the ci run of
 // theta30_s21.4_e10_cv0 (16 x 8 d: Delta_a > 0 at U = 2.50 d; U_end 5.08 d at Delta_a 5.13 d, 0.52 d per d after
-// it); k_a is that run's and the median of the 80 x 80 d square runs of 2026-12-03/04 at the paper's rate (U_end
+// it); k_a is that run's and the median of the 80 x 80 d square runs at G = 10 at the paper's rate (U_end
 // 10.4-24.8 d at Delta_a = 30 d, median 16.5 d: (16.5 - 2.5) / 30 = 0.47). Against runs: ci (5.0 d) 0.60x-1.24x
 // (U_end 4.04-8.39 d: theta0_s21.4_e10, theta15_s21.4_e5, theta30_s7.1/s21.4/s28.5_e10, cv 0), reduced 40 x 20 d
 // to 12 d (8.5 d) 1.00x (theta30_s21.4_e10_cv0: 8.49 d); 80 x 80 d (17.5 d) 0.71x (theta30_s28.5_e10_cv0, 24.8 d)
@@ -62,17 +62,17 @@ constexpr double kUAtInitiation = 2.5;     // d
 constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
 // The static start's U_c (first damage, theta30_s21.4_e10_cv0): 0.272 d at h_s = 8 d, 0.529 at 20, 1.057 at 80
 // (the ci, reduced and converged presets' sizes), 1.705 at 200 (the paper preset, `make bench-paper`'s static
-// start, 2026-12-05): k_c sqrt(h_s / d) with
+// start): k_c sqrt(h_s / d) with
 // k_c = 0.096-0.121; a low U_c skips less of the run, so k_c is on the low side of the larger sizes.
 constexpr double kUcPerSqrtHeight = 0.11;
 // Seconds per step. `lumped`: DOF-updates per second per core. Whole ci runs 52-93 M (the five cases above),
 // the whole reduced run 69 M, 2000 elastic steps at 80 x 80 d 109 M (user time less that of a 1-step run); on
-// the same machine kind unloaded `make bench` measured 127 M at 40 x 20 d (2026-12-06). 40 M allows for a
+// the same machine kind unloaded `make bench` measured 127 M at 40 x 20 d. 40 M allows for a
 // slower core, a larger specimen (fewer cache hits) and the fracture stage's interface law.
 constexpr double kLumpedDofUpdatesPerSecond = 40e6;
 // `paper` (consistent mass, CHOLMOD solve per step), per DOF: a + b x nodes of a slice (the factor's bandwidth);
 // measured 9.7e-8 s at 16 x 8 d (13.9 nodes a slice) and 1.22e-7 at 40 x 20 d (34.6), 3000 and 600 steps less
-// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench` (its cost growth as committed at c09beab). The
+// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench`'s cost growth. The
 // constants give 1.11x, 1.22x and 1.14x of these; at the paper preset's 346 nodes a slice, an extrapolation.
 constexpr double kPaperSecondsPerDof = 8e-8, kPaperSecondsPerDofSliceNode = 2e-9;
 // Set-up (the model, operators, integrator, c_d's block), per DOF: 1.8e-5 s user at 80 x 80 d (a 1-step run).

@@ -85,11 +85,11 @@ double kineticOverStrain(const Measurement& r);
 bool pastElasticStart(const Measurement& r);
 
 /// The quasi-static warning's ratio of a history row (warned above 0.05): the larger of kinetic / strain energy
-/// while the crack grows (the warning's only measure before 2026-12-06) and, from the elastic start on, the
-/// kinetic energy beyond the loading's own motion / strain energy (Measurement::kineticBeyond). Proportional
-/// loading at a steady rate moves the nodes without accelerating them: its kinetic energy grows as the rate
-/// squared and says nothing about inertia (kinetic / strain up to 0.23 before the crack grows in a ci run whose
-/// adaptive rate reaches x8, at most 0.008 beyond the loading's motion; up to 1.7 beyond it at rate_factor = 500).
+/// while the crack grows and, from the elastic start on, the kinetic energy beyond the loading's own motion /
+/// strain energy (Measurement::kineticBeyond). Proportional loading at a steady rate moves the nodes without
+/// accelerating them: its kinetic energy grows as the rate squared and says nothing about inertia (kinetic /
+/// strain up to 0.23 before the crack grows in a ci run whose adaptive rate reaches x8, at most 0.008 beyond the
+/// loading's motion; up to 1.7 beyond it at rate_factor = 500).
 /// 0 before the elastic start.
 double quasiStaticRatio(const Measurement& r);
 
@@ -107,7 +107,7 @@ struct GuardBounds {
   double balance = 0.25;
   double minWork = 0;     // balanceWorkFloor, 0.1 Gamma_i B d: below this much work the error is measured against it
   /// kinetic / strain energy while the crack grows (0.05 is the quasi-static warning). Ten times the largest
-  /// ratio of any completed run measured by 2026-12-03: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
+  /// ratio measured in a completed run: 0.322 (paper case theta30_s7.1_e10_cv0 at the ci preset;
   /// 0.299 at 80 x 80 d with the reduced far field, 0.156 at 100 x 100 d: docs/solver.md), so 3.2.
   double kinetic = 3.2;
   /// An R-curve point (J when the crack advanced) below -negativeJ: negative beyond round-off (1e-6 Gamma_i: J's

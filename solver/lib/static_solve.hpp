@@ -19,7 +19,7 @@ int blasThreadCount();
 /// the free partition is only semi-definite (a mechanism: a part free to move without straining anything),
 /// the mechanism stays where it is and `mechanism`, if given, is set. The BLAS runs at one thread for it, so that
 /// the solution does not depend on the thread count: OpenBLAS's threaded kernels add in another order on some
-/// CPUs (on an Intel Xeon with AVX-512, 2026-12-07, the transverse modulus differed in its last ~10 ulps between
+/// CPUs (on an Intel Xeon with AVX-512 the transverse modulus differed in its last ~10 ulps between
 /// one and two threads, and with it every later number of a run).
 VecX solveStaticPrescribed(const SpMat& K, const std::vector<int>& dofs, const std::vector<double>& values,
                            bool* mechanism = nullptr);

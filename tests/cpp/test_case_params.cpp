@@ -586,7 +586,7 @@ TEST(CaseParams, EveryChoiceParsesToTheEnumeratorOfItsName) {
             EXPECT_NE(fromFile.tomlText.find("\n" + line + "\n"), std::string::npos) << fromFile.tomlText;
         }
     }
-    EXPECT_GE(choiceKeys, 9u);  // the nine of 2026-12-06 at least: none dropped, a new one needs no edit here
+    EXPECT_GE(choiceKeys, 9u);  // at least nine: none dropped, a new one needs no edit here
     EXPECT_EQ(parse("rate_adapt_rule = \"margin\"\n").rate_adapt_rule, RateAdaptRule::margin);
     EXPECT_EQ(parse("").rate_adapt_velocity, RateAdaptVelocity::keep);
     EXPECT_EQ(parse("").rate_adapt_rho_high, enamel::kRateRhoHigh);  // the rule's own bound is the key's default

@@ -117,7 +117,7 @@ TEST(FarField, LongRodElementsTakeTheWeakestOfTheirParts) {
 // Before any damage, at a given applied displacement (the static elastic solution): the grips' load, J and
 // the displacement U_c at which the first interface reaches delta0, reduced against full, on a 25 x 24 d
 // specimen with a full band of +-4 d (2/3 of the height reduced). Stated tolerance 1.5% on each, for the far
-// fields this tolerance admits: theta_D = 0 with a node every 4 slices (measured 2026-12-02: load -0.7%, J
+// fields this tolerance admits: theta_D = 0 with a node every 4 slices (measured: load -0.7%, J
 // -0.7%, U_c +0.3%) and theta_D = 30 with a node every 2 slices (load +0.9%, J +1.2%, U_c -0.9%). At
 // theta_D = 30 every 4 slices is 4-5% too stiff (load +4.2%, J +4.9%, U_c -3.4%; every 8: +15%): the rods of
 // the two plies cross every ~1 d along x and bend between the crossings, which a rod element longer than

@@ -112,17 +112,17 @@ TEST(JIntegral, LoadedFacesTermsMatchAHandComputationWithReactionsAtTheRightEdge
 // loaded faces' slope of each profile, against the compliance and energy release rates of the same grips, as in
 // BoundaryJMatchesComplianceAndEnergyReleaseRates (P the force conjugate to U: sum of reaction x shape), at
 // theta_D = 30. J is the sum of the loaded faces' term and the face energies. With the grips turning to the right
-// edge those terms are about G itself, and J agrees with G within 4% (2.3% for uy, 3.4% for uxuy, measured
-// 2026-12-03). Turning about the centre, the pre-crack tip at a0 = w_s/2 sits where u_y = 0 and the right part
-// of the specimen is compressed: J is then the difference of a loaded faces' term and a right-face energy each
-// 20-30 G, and their discretisation error, a few percent of them (1.8% for uy, 6.4% for uxuy), is most of G
-// (J/G = 0.26 and -0.83): the outer-boundary J does not measure G there, and the test states that conditioning
-// and bounds the error by 10% of the terms rather than claiming agreement (docs/model.md, Loading). The grips
-// do change the specimen's compliance (each case tests its own shape and slope, not the default's). These bounds
-// were measured with the tip's crisscross intact (crisscross_at_tip = "intact", the default until 2026-12-06), which
-// the loop pins; with the default cut tip the crisscross lattice near the tip differs (it moves with a0 in both
-// readings) and J/G_c is 0.955 for to_right_edge uxuy (4.5%, measured 2026-12-06): the default's grips
-// (to_right_edge, uy) are checked at the cut tip, within 3%, by BoundaryJMatchesComplianceAndEnergyReleaseRates.
+// edge those terms are about G itself, and J agrees with G within 4% (measured: 2.3% for uy, 3.4% for uxuy).
+// Turning about the centre, the pre-crack tip at a0 = w_s/2 sits where u_y = 0 and the right part of the
+// specimen is compressed: J is then the difference of a loaded faces' term and a right-face energy each 20-30 G,
+// and their discretisation error, a few percent of them (1.8% for uy, 6.4% for uxuy), is most of G (J/G = 0.26
+// and -0.83): the outer-boundary J does not measure G there, and the test states that conditioning and bounds
+// the error by 10% of the terms rather than claiming agreement (docs/model.md, Loading). The grips do change the
+// specimen's compliance (each case tests its own shape and slope, not the default's). These bounds hold with the
+// tip's crisscross intact (crisscross_at_tip = "intact"), which the loop pins; with the default cut tip the
+// crisscross lattice near the tip differs (it moves with a0 in both readings) and J/G_c is 0.955 for
+// to_right_edge uxuy (4.5%): the default's grips (to_right_edge, uy) are checked at the cut tip, within 3%, by
+// BoundaryJMatchesComplianceAndEnergyReleaseRates.
 TEST(JIntegral, BoundaryJAgainstComplianceForEveryGripProfileAndConstraint) {
   const double theta = 30.0, B = std::sqrt(3.0), U = 0.01;
   const std::string intact = "crisscross_at_tip = \"intact\"\n";

@@ -624,9 +624,9 @@ TEST(Kernels, TimeOfDisplacementInvertsTheLoading) {
 // The static elastic start: the state is static equilibrium at U* = fraction U_c (free DOFs carry no net
 // force), its most loaded interface or rod element sits at exactly `fraction` of its limit, nothing is
 // inelastic, the time is where the loading reaches U*, and the external work is what the specimen holds.
-// The third model is larger (24 x 24 d). Before 2026-12-06 it held a mechanism (a0 = 40 h_e put a crisscross on
-// slice 40 and a rod's crossing exactly on slice 0, and round-off cut a rod end off onto a single interface);
-// with the pre-crack tip at a quarter point (docs/model.md, Geometry) it holds none, and says so.
+// The third model is larger (24 x 24 d). With the pre-crack tip at a quarter point (docs/model.md, Geometry) it
+// holds no mechanism, and says so (a tip at a0 = 40 h_e would put a crisscross on slice 40 and a rod's crossing
+// exactly on slice 0, and round-off would cut a rod end off onto a single interface: a mechanism).
 TEST(Kernels, StaticStartIsEquilibriumAtAFractionOfFirstDamage) {
   for (const char* integrator : {"lumped", "paper", "lumped24"}) {
     const bool large = std::string(integrator) == "lumped24";

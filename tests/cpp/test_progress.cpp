@@ -117,7 +117,7 @@ TEST(QuasiStatic, BeforeTheCrackGrowsOnlyTheMotionBeyondTheLoadingsCounts) {
   EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.0);  // elastic
   r.inelasticInterfaces = 2;
   EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.01);
-  r.crackAdvance = 0.5;  // while the crack grows, kinetic / strain energy as before 2026-12-06, or more
+  r.crackAdvance = 0.5;  // while the crack grows, kinetic / strain energy, or more
   EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.2);
   r.kineticBeyond = 0.3;
   EXPECT_DOUBLE_EQ(enamel::quasiStaticRatio(r), 0.3);

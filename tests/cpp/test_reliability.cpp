@@ -86,7 +86,7 @@ TEST(Guard, SoundRowsPass) {
 }
 
 TEST(Guard, EnergyBalanceIsCheckedWhateverTheSignOfTheWork) {
-  // the damaged run of 2026-12-03: external work -1e118 and energies of that size, "balance 0"
+  // a damaged run as seen: external work -1e118 and energies of that size, "balance 0"
   Measurement r = soundRow();
   r.external = -1.4e118;
   r.kinetic = 6e117;

@@ -74,7 +74,7 @@ TEST(RunTimeEstimate, PaperSchemeCostsMorePerStep) {
 
 // The block's dt is the one of the model the case builds: exactly for `paper` (the element's frequency, the same
 // h_e), and within 2% for `lumped` (omega_max, local: +1.2% here at 24 x 12 d against the 16 x 8 d block; -0.7% at
-// 40 x 20 d and -1.0% at 80 x 80 d, 2026-12-06, docs/cluster.md).
+// 40 x 20 d and -1.0% at 80 x 80 d, docs/cluster.md).
 TEST(StepScaleOfBlock, TimeStepIsTheFullModels) {
   for (const char* integrator : {"lumped", "paper"}) {
     const CaseParams p =

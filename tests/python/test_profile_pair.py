@@ -9,7 +9,7 @@ import pytest
 from bench import profile_pair as pp
 
 # `enamel-dem profile paper_cases/theta30_s21.4_e10_cv0.toml --preset ci --warmup 5 --steps 3` with
-# bench.run_bench.PROFILE_SETS and threads=1: the phases of the real step, in ms/step (2026-12-06, AMD EPYC).
+# bench.run_bench.PROFILE_SETS and threads=1: the phases of the real step, in ms/step (an AMD EPYC).
 CAPTURED = """\
 4488 DOF, 1 thread(s), scheme lumped, 3 steps timed after 5 warm-up steps: 0.03673 ms/step, 122.2 M DOF-updates/s per core; triad 13.2 GB/s; timers: 174 laps per step, a clock read 26 ns
 
@@ -30,7 +30,7 @@ CAPTURED = """\
 |   deletions | 3.7e-05 | 0% | 1 | - | - | - | deleteOverloadedBeams: the overloaded rod elements found and, where there are any, deleted |
 |   crack measure | 2.967e-05 | 0% | 1 | - | - | - | measureCrackAdvance, when something failed or broke |
 """
-# The same of an older binary (solver e22f90a's format: kernels in s/step, some of them timed alone), as
+# The same of an older binary (the older format: kernels in s/step, some of them timed alone), as
 # `--against` may be given one.
 CAPTURED_OLD = """\
 4488 DOF, 1 thread(s), 5 steps per kernel in 5 interleaved rounds (median round): 5.107e-05 s/step, 87.9 M DOF-updates/s per core; triad 32.8 GB/s

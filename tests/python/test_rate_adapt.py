@@ -14,10 +14,9 @@ from conftest import ROOT, run_with_kills
 from enamel_results.constants import KINETIC_WARN, LOADING_RATE  # the solver's warning bound and rate rule
 
 CASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
-# at G = 3 (the default before 2026-12-04): at G = 10 this ci run's kinetic/strain ratio reaches 0.075 (measured
-# 2026-12-04) past the 0.05 bound, so the adaptive rate x8 is not quasi-static there; the rule is tested where it is
-# and with the intact tip (the default before 2026-12-06): with the cut tip this run's ratio reaches 0.080 at step
-# 5592, before any crack advance (measured 2026-12-06)
+# at G = 3: at G = 10 this ci run's kinetic/strain ratio reaches 0.075 (measured) past the 0.05 bound, so the
+# adaptive rate x8 is not quasi-static there; the rule is tested where it is, and with the intact tip: with the
+# default cut tip this run's ratio reaches 0.080 at step 5592, before any crack advance (measured)
 SETS = ["stop_da_over_d=2", "threads=1", "Gamma_k_over_sigma0sq=3",
         'crisscross_at_tip="intact"']   # the ci preset stopped early: 0.6-1.5 s (10,409 steps)
 RHO_HIGH, RHO_LOW, RAISE, LOWER = (LOADING_RATE[k] for k in ("rho_high", "rho_low", "raise", "lower"))  # loading_rate.hpp
@@ -109,7 +108,7 @@ def test_restart_of_adaptive_run_is_bit_for_bit(enamel, adaptive, tmp_path):
     """Killed (SIGKILL) twice after a checkpoint while phi moves, continued with --restart: the same history
     (phi included), R-curve and step count as the uninterrupted run."""
     out = tmp_path / "killed"
-    # the whole run is 0.6 s on an AMD EPYC (2026-12-04): checkpoints every 0.02 s and kills 0.01 s after one, so
+    # the whole run is 0.6 s on an AMD EPYC: checkpoints every 0.02 s and kills 0.01 s after one, so
     # both kills land in the first half of the run on a machine several times faster
     kills = run_with_kills(enamel, out, lambda extra: args_for(out, 8, *extra), [0.01, 0.01], timeout=600,
                            every=0.02)

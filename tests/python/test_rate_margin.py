@@ -1,8 +1,7 @@
 """The adaptive rate's margin rule (rate_adapt_rule = "margin") and its velocity correction (rate_adapt_velocity =
 "quasi_static"; solver/lib/loading_rate.hpp, docs/solver.md, Adaptive loading rate) on ci runs of theta30 (the ci
-preset's full run at the default model these were measured at, G = 10 with the intact tip, pinned in ci(): rods
-break there; with today's default, G = 9 and the cut tip, the first rod break of margin8 does fall at phi = 1,
-measured 2026-12-06):
+preset's full run at G = 10 with the intact tip, pinned in ci(): rods break there; at the default, G = 9 and the
+cut tip, the first rod break of margin8 does fall at phi = 1, measured):
 
 - neither key changes a run that does not change phi: with rate_adapt_max = 1 (the default) the margin rule's
   forecast and the velocity correction leave every dataset of the default run as it is, bit for bit, and add no
@@ -85,7 +84,7 @@ def test_rate_is_one_at_the_first_interface_failure(margin8, default_run):
     assert h["step"][-1] < 0.5 * default_run["history/step"][-1]
 
 
-@pytest.mark.xfail(strict=True, reason="measured 2026-12-06 (AMD EPYC): the first rod break of this run falls in an "
+@pytest.mark.xfail(strict=True, reason="measured (AMD EPYC): the first rod break of this run falls in an "
                    "interval from phi 1.25 to 1: the rod's forecast read 3-16 rows over 7 rows at phi 1, then 54 "
                    "rows on the row before the break, and phi rose x1.25 (docs/solver.md, Adaptive loading rate)")
 def test_rate_is_one_at_the_first_rod_break(margin8):

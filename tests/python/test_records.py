@@ -140,7 +140,7 @@ def test_record_holds_the_figures_frames_and_says_when_asked_for_another(tiny, t
 
 
 def test_record_is_small_against_its_result_file(ci_run, tmp_path):
-    """A ci run's record is under 5% of its result.h5 (22 kB of 887 kB on 2026-12-06; an 80 x 80 d run's 83 kB
+    """A ci run's record is under 5% of its result.h5 (22 kB of 887 kB measured; an 80 x 80 d run's 83 kB
     of 6.2 MB) and is text that git can diff: JSON, one line per field or list, no gzip."""
     h5 = ci_run(FIG4[2])
     record = tmp_path / "r.json"

@@ -54,9 +54,9 @@ def test_theta0_gives_four_thirds_at_the_reduced_size_in_the_slow_limit(run, tmp
     """The `reduced` specimen (40 x 20 d, Delta_a 12 d) at half and a quarter of the preset's loading rate: R falls
     as the rate falls (the excess over 4/3 is the loading's kinetic share), and the slow limit, extrapolated from
     the two as R(r/2) - (R(r) - R(r/2))/3 (the excess taken as growing with the square of the rate, the stricter
-    of the linear and quadratic readings: it leaves the larger limit), is within 3% of 4/3. Measured 2026-12-04
-    at G = 10: R_ss 1.390 (+4.2%) at half, 1.373 (+3.0%) at a quarter, limit 1.368 (+2.6%); R_init 1.361, 1.347,
-    limit 1.342. (At G = 3, before 2026-12-04, half the rate alone was within 3%: 1.365 / 1.344.) The static
+    of the linear and quadratic readings: it leaves the larger limit), is within 3% of 4/3. Measured at G = 10:
+    R_ss 1.390 (+4.2%) at half, 1.373 (+3.0%) at a quarter, limit 1.368 (+2.6%); R_init 1.361, 1.347, limit
+    1.342. (At G = 3 half the rate alone is within 3%: 1.365 / 1.344.) The static
     elastic start keeps each run to 1-2 min (one thread: two oversubscribed OpenMP threads spin on a busy
     machine)."""
     got = {}
@@ -103,7 +103,7 @@ def test_inelastic_reach_and_the_edge_warning(theta0, theta30):
 
 
 def test_theta30_runs_to_stop_with_broken_rods_and_a_rising_rcurve(theta30):
-    # at the default G = 10 (since 2026-12-04) rods break at the ci size too (6 rod elements; at G = 3 none did):
+    # at the default G rods break at the ci size too (6 rod elements at G = 10; at G = 3 none do):
     # R rises above R_init and falls back at each break, a sawtooth, so the rise is asked of the maximum
     meta = theta30["meta"].attrs
     assert meta["status"] == "completed", meta["stop_reason"]

@@ -36,7 +36,7 @@ def test_estimated_steps_of_a_ci_run_are_within_3x_of_the_real_ones(run, ci_run,
 
 def test_block_time_step_is_the_full_models_at_the_reduced_size(run):
     """The reduced preset (40 x 20 d, dt_factor 0.22): the 16 x 8 d block's dt within 2% of the built model's
-    (0.7% below it on 2026-12-06)."""
+    (0.7% below it, measured)."""
     est = estimate(run, "theta30_s21.4_e10_cv0", "reduced")
     built = run("info", PAPER_CASES / "theta30_s21.4_e10_cv0.toml", "--preset", "reduced")
     assert built.returncode == 0, built.stderr

@@ -32,8 +32,8 @@ def fast_run(run, out, stop_u):
 
 def test_a_run_far_from_quasi_static_is_warned_though_its_crack_never_grows(run, tmp_path):
     # 500 times the ci loading rate, stopped at U = 100 d (~2 s): rods break, interfaces soften, the crack stays.
-    # At G = 10 with the intact tip (the default until 2026-12-06): with the cut tip the crack grows 0.53 d and the
-    # run blows up (kinetic / strain 9.07, measured 2026-12-06), which is not the case tested here.
+    # At G = 10 with the intact tip: with the default cut tip the crack grows 0.53 d and the run blows up (kinetic /
+    # strain 9.07, measured), which is not the case tested here.
     out = tmp_path / "fast"
     r = fast_run(run, out, 100)
     with h5py.File(out / "result.h5", "r") as f:
@@ -51,8 +51,8 @@ def test_a_run_far_from_quasi_static_is_warned_though_its_crack_never_grows(run,
 
 def test_the_stop_row_counts_in_the_quasi_static_maximum(run, tmp_path):
     # The fast run above stopped at U = 23.8 d: its stop (step 1654, between two history rows) falls where the
-    # ratio beyond the loading's motion is larger than at any row before it (1.5533 against 1.5526, measured
-    # 2026-12-07); the run's maximum must include that row, as the loop's rows are included.
+    # ratio beyond the loading's motion is larger than at any row before it (1.5533 against 1.5526, measured); the
+    # run's maximum must include that row, as the loop's rows are included.
     out = tmp_path / "stop"
     fast_run(run, out, 23.8)
     with h5py.File(out / "result.h5", "r") as f:
