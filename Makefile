@@ -32,15 +32,16 @@
 #                       (98 min on 2 cores at G = 3, 141 min at G = 9; at the solver's default G, which the report's
 #                       header names); resumable: Ctrl-C stops the runs at a checkpoint, the same command continues
 #                       (BENCH_FRESH=1: all again): bench/results.csv, bench/cost_growth.csv, bench/results.md, bench/out/*.png
-#   make bench-converged  [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10 ..."]  three
-#                       cases at the `converged` preset to Delta_a = 30 d, each by c09beab's build (built once in
-#                       build/baseline-c09beab/: the cost's baseline), by build/enamel-dem with CONVERGED_SET (new)
-#                       and without it (the R-curve's reference; --reference-set in CONVERGED_ARGS), one thread a
-#                       run, JOBS at once, resumable (6-9 runs of 23-37 min at c09beab's speed): bench/converged_cost.md
+#   make bench-converged  [BASELINE=commit] [CONVERGED_SET="key=value ..."] [CONVERGED_ARGS="--preset ci --nice 10
+#                       ..."]  three cases at the `converged` preset to Delta_a = 30 d, each by the build of commit
+#                       BASELINE (default in the Makefile; built once in build/baseline-<commit>/: the baseline),
+#                       by build/enamel-dem with CONVERGED_SET (new) and without it (the R-curve's reference;
+#                       --reference-set in CONVERGED_ARGS), one thread a run, JOBS at once, resumable (6-9 runs of
+#                       23-37 min at the default baseline's speed): bench/converged_cost.md
 #   make bench-step     instructions and cache misses per phase of the step, per DOF and per node (valgrind; ~3 min):
 #                       bench/step_instructions.md
 #   make bench-paper    [PAPER_SET="key=value ..."]  one `paper`-preset case (200 x 200 d, 1.39 M DOF) to Delta_a =
-#                       30 d at the preset's rate from the static start (1.23 h on 2 cores of an AMD EPYC, 2026-12-06;
+#                       30 d at the preset's rate from the static start (~1.2 h on 2 cores; the report says how long;
 #                       Ctrl-C writes a checkpoint, the same command continues), judged against the 15 min goal and
 #                       against the committed record bench/paper_preset_record.json (the same R-curve):
 #                       bench/paper_preset.md, bench/out/paper_preset.png
@@ -144,11 +145,12 @@ bench: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.run_bench --jobs $(JOBS) \
 	  $(if $(BENCH_G),--G $(BENCH_G)) $(if $(BENCH_FRESH),--fresh)
 
-# A converged run's cost: c09beab's build against this one (or CONVERGED_SET on it), the same R-curve decided by
+# A converged run's cost: BASELINE's build against this one (or CONVERGED_SET on it), the same R-curve decided by
 # enamel_results.metrics.same_rcurve. CONVERGED_ARGS passes more options (bench/converged_cost.py --help).
+BASELINE ?= c09beab
 bench-converged: $(ENAMEL)
 	ENAMEL_BINARY=$(abspath $(ENAMEL)) PYTHONUNBUFFERED=1 $(PYTHON) -m bench.converged_cost --jobs $(JOBS) \
-	  $(foreach s,$(CONVERGED_SET),--set '$(s)') $(CONVERGED_ARGS)
+	  --baseline $(BASELINE) $(foreach s,$(CONVERGED_SET),--set '$(s)') $(CONVERGED_ARGS)
 
 # Instructions and cache misses per phase of the step, per DOF and per node (valgrind callgrind; independent of how
 # busy the machine is). BENCH_STEP_AGAINST=path/to/older/enamel-dem counts a second binary beside it.
