@@ -4,6 +4,7 @@ itself as zero error, and computes the errors of the other variants against it. 
 timing is asserted here (`make bench` measures). Also `make bench-paper`'s script (bench/paper_preset.py):
 interrupted and continued."""
 import csv
+import datetime
 import math
 import os
 import signal
@@ -296,9 +297,10 @@ def test_bench_G_is_the_solver_default_unless_given(enamel):
     listed = float(row.split("|")[3])
     assert run_bench.bench_physics(binary=enamel) == {"Gamma_k_over_sigma0sq": listed}
     assert run_bench.bench_physics(3.0, binary=enamel) == {"Gamma_k_over_sigma0sq": 3.0}
-    header = dict(date="2026-12-06 09:00", machine="AMD EPYC", git="abc", preset="reduced", jobs=2, total_min=98.0,
+    when = datetime.datetime(2026, 12, 6, 9, 0).strftime("%Y-%m-%d %H:%M")   # as the bench stamps its report
+    header = dict(date=when, machine="AMD EPYC", git="abc", preset="reduced", jobs=2, total_min=98.0,
                   G=listed, G_source="the solver's default, `enamel-dem keys`")
     md = run_bench.summary_markdown([], [], header)
-    assert md.splitlines()[0] == f"# Bench results (2026-12-06 09:00, G = {listed:g})"
+    assert md.splitlines()[0] == f"# Bench results ({when}, G = {listed:g})"
     assert f"G = Gamma_k_over_sigma0sq = {listed:g} (the solver's default" in md
     assert run_bench.parser().parse_args(["--G", "3"]).G == 3.0 and run_bench.parser().parse_args([]).G is None

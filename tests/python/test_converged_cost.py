@@ -3,6 +3,7 @@ current binary as both baseline and new (stopped by SIGINT at a checkpoint, then
 new one, judged against a reference run), and its verdict and table from crafted numbers. Correctness only: no speed is asserted (the ratio of one binary against itself is
 whatever the machine gives)."""
 import csv
+import datetime
 import json
 import math
 import os
@@ -128,6 +129,11 @@ def test_verdict(ratio, same, met):
         assert ("not the same R-curve" in words) is (not same)
 
 
+def stamp(hour: int) -> str:
+    """A UTC time as the harness writes it (header_of, the runs' starts)."""
+    return datetime.datetime(2026, 12, 6, hour, 0).strftime("%Y-%m-%d %H:%M")
+
+
 def crafted_row(case, b_core, n_core, same):
     ratio = b_core / n_core
     met, words = converged_cost.verdict(ratio, same, why="" if same else "R mean -2.5%")
@@ -140,7 +146,7 @@ def crafted_row(case, b_core, n_core, same):
                               ("new", n_core, 272182)):
         row.update({f"{role}_core_s": core, f"{role}_wall_s": core * 1.01, f"{role}_steps": steps,
                     f"{role}_dof": 222816, f"{role}_pieces": 1, f"{role}_threads": 1, f"{role}_G": 10.0,
-                    f"{role}_git": "abc", f"{role}_machines": "AMD EPYC", f"{role}_started_utc": "2026-12-06 07:00"})
+                    f"{role}_git": "abc", f"{role}_machines": "AMD EPYC", f"{role}_started_utc": stamp(7)})
     return row
 
 
@@ -162,7 +168,7 @@ def test_table_from_crafted_numbers(tmp_path):
             crafted_row("b", 1376.0, 400.0, False),
             crafted_row("c", 1376.0, 1376.0 / 3.2, True), dict(case="d", status="incomplete", met=False,
                                                              verdict=converged_cost.verdict(math.nan, None)[1])]
-    header = dict(date="2026-12-06 08:00", machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
+    header = dict(date=stamp(8), machine="AMD EPYC, 2 cores", preset="converged", G="10", jobs=2, nice="",
                   goal=3.0, baseline="c09beab", new="build/enamel-dem", baseline_git="c09beab539e9",
                   new_git="abc", new_sets=" (no --set: its defaults)", both_sets="", reference="solver abc")
     md_path, csv_path = converged_cost.write_table(rows, header, tmp_path)
