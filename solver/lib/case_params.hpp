@@ -183,6 +183,11 @@ enum class Need { required, optional };
     X(rod_damping, Choice, numerics, optional, RodDamping::implicit, "[]", 0, 0, "-",                              \
       "rods' stiffness damping (integrator lumped): implicit = the full b K of the rods, solved rod by rod "        \
       "at each step (the paper's model); capped = explicit, b' = min(b, damping_cap / omega_max)")                  \
+    X(step_rule, Choice, numerics, optional, StepRule::rods, "[]", 0, 0, "-",                                       \
+      "time step rule (integrator lumped): rods = dt_factor x the smallest period of the whole lumped system "      \
+      "(rotary inertia scaled until rotations stop governing); interfaces = dt_factor x the smallest period of "   \
+      "the interfaces on the rods' masses, physical rotary inertia (rod_damping implicit only: the rods' "          \
+      "implicit b K keeps their faster modes stable; dt <= 2 b)")                                                   \
     X(damping_cap, Real, numerics, optional, 1, "(]", 0, 2, "-",                                                    \
       "stiffness damping cap (integrator lumped, rod_damping capped): b' = min(b, damping_cap / omega_max), i.e. "  \
       "the stiffness-proportional damping ratio at omega_max is at most damping_cap / 2; a lower cap raises "       \

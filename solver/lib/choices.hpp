@@ -56,6 +56,7 @@ ENAMEL_NAMED_ENUM(FarFieldRodBreaks, stop, allow)                // far_field_ro
 ENAMEL_NAMED_ENUM(IntegratorScheme, paper, lumped)               // integrator (integrators/registry.cpp)
 ENAMEL_NAMED_ENUM(LinearSolver, cholmod, umfpack)                // linear_solver
 ENAMEL_NAMED_ENUM(RodDamping, implicit, capped)                  // rod_damping (integrators/rod_damping.hpp)
+ENAMEL_NAMED_ENUM(StepRule, rods, interfaces)                    // step_rule (integrators/lumped.cpp)
 ENAMEL_NAMED_ENUM(DeletionRule, most_overloaded, all)            // deletion_rule
 ENAMEL_NAMED_ENUM(RateAdaptRule, energy, margin)                 // rate_adapt_rule (loading_rate.hpp)
 ENAMEL_NAMED_ENUM(RateAdaptVelocity, keep, quasi_static)         // rate_adapt_velocity (loading_rate.hpp)

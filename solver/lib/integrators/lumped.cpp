@@ -42,11 +42,11 @@ double rotaryScaleForTranslationalLimit(const beam::Section& s, double L) {
   return hi;
 }
 
-// Largest frequency of the assembled undamped system M^-1 (K + K_iface) with a diagonal mass, by power
-// iteration (prescribed DOFs held). Interfaces enter through their elastic force at a small amplitude (the
-// law is linear below delta0, contact included), never assembled.
+// Largest frequency of the assembled undamped system M^-1 (K + K_iface) with a diagonal mass (M^-1 K_iface
+// without the rods: withRods false), by power iteration (prescribed DOFs held). Interfaces enter through their
+// elastic force at a small amplitude (the law is linear below delta0, contact included), never assembled.
 double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law& law, const Operators& ops,
-                        const VecX& invMass) {
+                        const VecX& invMass, bool withRods) {
   const int n = static_cast<int>(invMass.size());
   VecX x = VecX::Zero(n), f(n), y(n);
   // A fixed start vector, drawn node by node along each rod (rod by rod), so that neither the estimate nor
@@ -70,7 +70,8 @@ double estimateOmegaMax(const CaseParams& p, const Model& m, const cohesive::Law
   for (int it = 0; it < 300; ++it) {
     x *= amplitude / x.cwiseAbs().maxCoeff();
     computeForcesForInterfaces(m, law, ops, x, lambdaMax, false, f);
-    y = invMass.cwiseProduct(ops.K * x + f);
+    if (withRods) f += ops.K * x;
+    y = invMass.cwiseProduct(f);
     for (int dof : ops.prescribedDofs) y[dof] = 0;
     const double next = x.dot(y.cwiseQuotient(invMass)) / x.dot(x.cwiseQuotient(invMass));
     x = y;
@@ -97,6 +98,9 @@ alignas(16) constexpr double kNoWrench[6] = {0, 0, 0, 0, 0, 0};
 //      c = damping_cap (the stiffness part's damping ratio at omega_max at most c/2).
 //   dt = dt_factor x 2 pi / omega_max (the smallest period of this system), refused above the limit
 //   2 / omega_max (sqrt(1 + xi^2) - xi), xi = a / (2 omega_max) (+ b' omega_max / 2 when capped).
+//   step_rule = interfaces (implicit only): omega_max that of M^-1 K_I alone and the rotary inertia physical. The
+//   step is then stable when M - dt^2/4 K_I > 0 and dt <= 2 b: implicit b K adds dt/2 b K to the mass of the
+//   step's stability form M + dt/2 C - dt^2/4 (K + K_I), which covers the rods' dt^2/4 K.
 // One step, from q_n and the half-step velocity v_{n-1/2} (State::vHalf), forces first (as written for capped;
 // implicit: b' = 0 in the pass, then solveRodDampingOfStep below):
 //   f_iface(q_n) = K_I q_n + f_corr, K q_n, K v_{n-1/2}  (forces for interfaces, for beams: every interface's
@@ -124,7 +128,12 @@ class LumpedIntegrator : public Integrator {
   LumpedIntegrator(const CaseParams& p, const Model& m, const Materials& mat, const Operators& ops)
       : dampA_(mat.dampA) {
     const double L = m.beamLength;
-    rotaryScale_ = rotaryScaleForTranslationalLimit(mat.section, L);
+    implicit_ = p.rod_damping == RodDamping::implicit;
+    interfaceStep_ = p.step_rule == StepRule::interfaces;
+    if (interfaceStep_ && !implicit_)
+      throw IntegratorError("step_rule = \"interfaces\" needs rod_damping = \"implicit\": only the rods' implicit "
+                            "b K keeps their own faster modes stable at the interfaces' step");
+    rotaryScale_ = interfaceStep_ ? 1.0 : rotaryScaleForTranslationalLimit(mat.section, L);
     rows_.K = toNodeBlocks(SpMatRow(ops.K));
     rows_.KI = elasticInterfaceBlocks(m, mat.law, ops);
     if (cpuHasAvx512()) rows_.KIocts = octsOfSplit(rows_.KI.split);  // empty where K_I is not split
@@ -152,8 +161,7 @@ class LumpedIntegrator : public Integrator {
     }
     rows_.gripResidual = VecX::Zero(static_cast<Eigen::Index>(ops.prescribedDofs.size()));
     for (double shape : ops.prescribedShape) largestShape_ = std::max(largestShape_, std::abs(shape));
-    omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_);
-    implicit_ = p.rod_damping == RodDamping::implicit;
+    omegaMax_ = estimateOmegaMax(p, m, mat.law, ops, invMass_, !interfaceStep_);
     bEff_ = implicit_ ? mat.dampB : std::min(mat.dampB, p.damping_cap / omegaMax_);
     dt_ = p.dt_factor * 2.0 * M_PI / omegaMax_;
     const double xi = (implicit_ ? 0.0 : 0.5 * bEff_ * omegaMax_) + 0.5 * mat.dampA / omegaMax_;
@@ -164,6 +172,14 @@ class LumpedIntegrator : public Integrator {
           << " x smallest period 2 pi/omega_max of the lumped system) is above the stable limit 0.95 x "
           << limit << " (omega_max = " << omegaMax_ << ", damping ratio there " << xi
           << "): use dt_factor <= " << 0.95 * limit * omegaMax_ / (2 * M_PI);
+      throw IntegratorError(msg.str());
+    }
+    if (interfaceStep_ && dt_ > 2.0 * bEff_) {
+      std::ostringstream msg;
+      msg << "time step dt = " << dt_ << " is above 2 b = " << 2.0 * bEff_
+          << ", where the rods' implicit damping stops covering their stiffness (step_rule = \"interfaces\"): "
+             "use dt_factor <= "
+          << 2.0 * bEff_ * omegaMax_ / (2 * M_PI);
       throw IntegratorError(msg.str());
     }
     if (implicit_) {
@@ -185,7 +201,8 @@ class LumpedIntegrator : public Integrator {
   double addedRotaryInertia() const override { return rotaryScale_ - 1.0; }
   std::string describe() const override {
     std::ostringstream o;
-    o << "lumped mass, rotary inertia x " << rotaryScale_ << ", omega_max " << omegaMax_
+    o << "lumped mass, rotary inertia x " << rotaryScale_ << (interfaceStep_ ? ", omega_max of the interfaces " : ", omega_max ")
+      << omegaMax_
       << (implicit_ ? ", stiffness damping b K implicit rod by rod, b " : ", stiffness damping capped, b' ") << bEff_
       << (implicit_ ? " (" + std::to_string(rodSolve_.factors.size()) + " distinct node factors)" : std::string())
       << ", " << rows_.K.values.size() / 36
@@ -407,6 +424,7 @@ class LumpedIntegrator : public Integrator {
 
   double dt_ = 0, rotaryScale_ = 1, omegaMax_ = 0, bEff_ = 0, dampA_ = 0;
   bool implicit_ = true;             // rod_damping = implicit: the rods' b K solved at each step
+  bool interfaceStep_ = false;       // step_rule = interfaces: omega_max of M^-1 K_I, physical rotary inertia
   RodDampingSolve rodSolve_;         // its factors (rod_damping.hpp)
   VecX vStar_, KvGrip_;              // the pass's v*, and the grips' rows of K v_{n+1/2}
   std::vector<int> sliceOfNode_;     // per node: its slice
