@@ -183,14 +183,9 @@ class LumpedIntegrator : public Integrator {
       throw IntegratorError(msg.str());
     }
     if (implicit_) {
-#if defined(_OPENMP)
-      const int lanes = omp_get_max_threads();
-#else
-      const int lanes = 1;
-#endif
       sliceOfNode_ = m.nodeSlice;
       rodSolve_ = factoriseRodDamping(ops.K, mass_, ops.prescribedDofs, m.nodeRod, 1.0 + 0.5 * dampA_ * dt_,
-                                      dt_ * bEff_, lanes);
+                                      dt_ * bEff_);
     }
   }
 
@@ -348,32 +343,37 @@ class LumpedIntegrator : public Integrator {
     addShareOfTimers(mine, share, *timers_);
   }
 
-  // The rods' damping, implicit (the class comment): v_{n+1/2} from the pass's v* (the pass left q_n in place),
-  // q_{n+1} = q_n + dt v_{n+1/2}, and the slices' sums again: max |dt v|, max |q|, v.Mv and v.Kv (on a free row
-  // from the solve's identity, on a grip's from its row of K); the grips' b K v into their residuals.
+  // The rods' damping, implicit (the class comment): v_{n+1/2} from the pass's v* (the pass left q_n in place);
+  // then slice by slice q_{n+1} = q_n + dt v_{n+1/2} and the slice's sums: max |dt v|, max |q|, v.Mv and v.Kv (on
+  // a free row from the solve's identity dt b (K v)_f = s m_f (v*_f - v_f); on a grip's v* = v, and its v.Kv from
+  // its row of K); the grips' b K v into their residuals.
   void solveRodDampingOfStep(const Operators& ops, State& s) {
-    vStar_ = s.vHalf;
-    solveRodDamping(rodSolve_, s.vHalf);
-    multiplyGripRows(rodSolve_, s.vHalf, KvGrip_);
-    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) rows_.gripResidual[i] += bEff_ * KvGrip_[i];
+    std::swap(s.vHalf, vStar_);  // v* (the pass's) kept; s.vHalf becomes the solve's output
+    s.vHalf.resize(vStar_.size());
+    solveRodDamping(rodSolve_, vStar_, s.vHalf);
     const int slices = static_cast<int>(sliceSums_.size());
-    const double cInv = 1.0 / rodSolve_.c;
+    const double cInv = 1.0 / rodSolve_.c, dt = dt_;
+    double* q = s.q.data();
+    const double *v = s.vHalf.data(), *vStar = vStar_.data(), *mass = mass_.data(), *scale = rodSolve_.rhsScale.data();
 #pragma omp parallel for schedule(static)
     for (int k = 0; k < slices; ++k) {
-      double largestStep = 0, largest = 0, workM = 0, workK = 0;
+      double largestStep = 0, largestValue = 0, workM = 0, workK = 0;
       for (int dof = 6 * ops.sliceNodeStart[k]; dof < 6 * ops.sliceNodeStart[k + 1]; ++dof) {
-        const double v = s.vHalf[dof], step = dt_ * v;
-        s.q[dof] += step;
-        largestStep = std::max(largestStep, std::abs(step)), largest = std::max(largest, std::abs(s.q[dof]));
-        workM += v * mass_[dof] * v;
-        if (rows_.gripOfDof[dof] < 0) workK += v * rodSolve_.rhsScale[dof] * (vStar_[dof] - v) * cInv;
+        const double step = dt * v[dof], y = q[dof] + step;
+        q[dof] = y;
+        largestStep = std::max(largestStep, std::abs(step)), largestValue = std::max(largestValue, std::abs(y));
+        workM += v[dof] * mass[dof] * v[dof];
+        workK += v[dof] * scale[dof] * (vStar[dof] - v[dof]);
       }
-      SliceSums& sums = sliceSums_[k];
-      sums.largestStep = DoublePair{largestStep, 0}, sums.largestValue = DoublePair{largest, 0};
-      sums.workM = DoublePair{workM, 0}, sums.workK = DoublePair{workK, 0};
+      SliceSums& out = sliceSums_[k];
+      out.largestStep = DoublePair{largestStep, 0}, out.largestValue = DoublePair{largestValue, 0};
+      out.workM = DoublePair{workM, 0}, out.workK = DoublePair{workK * cInv, 0};
     }
-    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i)  // the grips' v.Kv, to the slice of their node
+    multiplyGripRows(rodSolve_, s.vHalf, KvGrip_);
+    for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
+      rows_.gripResidual[i] += bEff_ * KvGrip_[i];
       sliceSums_[sliceOfNode_[ops.prescribedDofs[i] / 6]].workK[1] += s.vHalf[ops.prescribedDofs[i]] * KvGrip_[i];
+    }
   }
 
   // R_p = K q + f_iface + b' K v_{n-1/2} + m_p (a_p + a v_p) at t_n, with

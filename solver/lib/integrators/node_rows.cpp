@@ -31,7 +31,10 @@ namespace {
   using Pair = DoublePair;
   const NodeBlockMatrix& K = rows.K;
   Pair Kq[3], Kv[3];
-  if (!K.split.empty()) {
+  if (!K.split.empty() && c.b == 0) {  // the rods' damping is taken after the pass (rod_damping implicit): K q only
+    multiplyBlockRowGroups<kRodGroups>(K, node, q, Kq);
+    for (int j = 0; j < 3; ++j) Kv[j] = Pair{0, 0};
+  } else if (!K.split.empty()) {
     multiplyBlockRowSplitPairs(K, node, q, v, Kq, Kv);
   } else {
     Vec6 a, b;

@@ -9,6 +9,10 @@
 
 #include "errors.hpp"
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace enamel {
 
 namespace {
@@ -100,7 +104,7 @@ std::vector<char> prescribedMask(int dofs, const std::vector<int>& prescribedDof
   return mask;
 }
 
-// The prescribed DOFs' columns in the free rows (c K(f, p)) and their rows of K.
+// The prescribed DOFs' columns in the free rows (c K(f, p)), by the free row's node, and their rows of K.
 void collectGripCouplings(const SpMat& K, const std::vector<int>& prescribedDofs, const std::vector<char>& prescribed,
                           RodDampingSolve& f) {
   f.gripColumns.clear(), f.gripRowStart.assign(1, 0), f.gripRowDof.clear(), f.gripRowK.clear();
@@ -111,6 +115,36 @@ void collectGripCouplings(const SpMat& K, const std::vector<int>& prescribedDofs
       if (!prescribed[r]) f.gripColumns.push_back({r, p, f.c * it.value()});
     }
     f.gripRowStart.push_back(static_cast<int>(f.gripRowDof.size()));
+  }
+  std::stable_sort(f.gripColumns.begin(), f.gripColumns.end(),
+                   [](const auto& a, const auto& b) { return a.freeDof / 6 < b.freeDof / 6; });
+  const int nodes = static_cast<int>(prescribed.size() / 6);
+  f.nodeGripStart.assign(nodes + 1, 0);
+  for (const auto& g : f.gripColumns) ++f.nodeGripStart[g.freeDof / 6 + 1];
+  for (int node = 0; node < nodes; ++node) f.nodeGripStart[node + 1] += f.nodeGripStart[node];
+}
+
+// Each distinct pair's two group blocks; refused where a factor couples the groups.
+void splitFactorsByGroups(RodDampingSolve& f) {
+  constexpr auto& G = RodDampingSolve::kGroups;
+  for (std::size_t i = f.groupFactors.size(); i < f.factors.size(); ++i) {
+    const RodDampingSolve::Factors& x = f.factors[i];
+    RodDampingSolve::GroupFactors out;
+    for (int g = 0; g < 2; ++g)
+      for (int k = 0; k < 3; ++k) {
+        out.Sinv[g][k] = out.P[g][k] = out.PT[g][k] = RodDampingSolve::Quad{0, 0, 0, 0};
+        for (int r = 0; r < 3; ++r) {
+          out.Sinv[g][k][r] = x.Sinv(G[g][r], G[g][k]);
+          out.P[g][k][r] = x.P(G[g][r], G[g][k]);
+          out.PT[g][k][r] = x.P(G[g][k], G[g][r]);
+        }
+      }
+    for (int r : G[0])
+      for (int k : G[1])
+        if (x.Sinv(r, k) != 0 || x.Sinv(k, r) != 0 || x.P(r, k) != 0 || x.P(k, r) != 0)
+          throw IntegratorError("rod damping: a rod's factors couple (ux, uy, rz) with (uz, rx, ry): a rod out of "
+                                "its xy-plane, which the rods' solve does not take");
+    f.groupFactors.push_back(out);
   }
 }
 
@@ -145,10 +179,79 @@ long factoriseNodes(const SpMat& K, const VecX& mass, const std::vector<char>& p
   return count;
 }
 
+// Subnormal results flushed to zero while it lives (this thread's MXCSR, restored after): the sweeps carry a
+// rod's values down the rod with a factor below one per node, so a DOF that moves little (the out-of-plane group)
+// decays through the subnormals, which cost the CPU ~100 cycles an operation. A flushed value is below 2.2e-308.
+struct FlushSubnormals {
+#if defined(__SSE2__)
+  unsigned saved = _mm_getcsr();
+  FlushSubnormals() { _mm_setcsr(saved | 0x8040); }  // FTZ (bit 15) and DAZ (bit 6)
+  ~FlushSubnormals() { _mm_setcsr(saved); }
+#endif
+};
+
+// The sweeps compiled for three CPUs, as node_rows.cpp's rows (the loader picks one; x86-64-v3 and v4 the same bits,
+// the default x86-64 within round-off of them).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define ENAMEL_CPU_CLONES [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]]
+#else
+#define ENAMEL_CPU_CLONES
+#endif
+
+using Quad = RodDampingSolve::Quad;
+constexpr auto& kGroups = RodDampingSolve::kGroups;
+
+// column k of a 3 x 3 block times x[kGroups[g][k]], summed over k (always inlined: no quad crosses a call, so
+// GCC's note on the AVX calling convention does not apply)
+#pragma GCC diagnostic ignored "-Wpsabi"
+[[gnu::always_inline]] inline Quad times(const Quad* B, const double* x, int g) {
+  return B[0] * x[kGroups[g][0]] + B[1] * x[kGroups[g][1]] + B[2] * x[kGroups[g][2]];
+}
+
+// Forward: y_i = rhs_i - P_i y_p, into v, over one lane's nodes in ascending order.
+ENAMEL_CPU_CLONES void sweepForward(const RodDampingSolve& f, const std::vector<int>& nodes, const VecX& vStar, VecX& v) {
+  for (int node : nodes) {
+    double* y = v.data() + 6 * node;
+    for (int d = 0; d < 6; ++d) y[d] = f.rhsScale[6 * node + d] * vStar[6 * node + d];
+    for (int e = f.nodeGripStart[node]; e < f.nodeGripStart[node + 1]; ++e)
+      v[f.gripColumns[e].freeDof] -= f.gripColumns[e].cK * vStar[f.gripColumns[e].gripDof];
+    const int p = f.before[node];
+    if (p < 0) continue;
+    const RodDampingSolve::GroupFactors& F = f.groupFactors[f.factorsOf[node]];
+    const Quad y0 = times(F.P[0], v.data() + 6 * p, 0), y1 = times(F.P[1], v.data() + 6 * p, 1);
+    for (int k = 0; k < 3; ++k) y[kGroups[0][k]] -= y0[k], y[kGroups[1][k]] -= y1[k];
+  }
+}
+
+// Backward: v_i = S_i^-1 y_i - P_n^T v_n, in place, over one lane's nodes in descending order.
+ENAMEL_CPU_CLONES void sweepBackward(const RodDampingSolve& f, const std::vector<int>& nodes, VecX& v) {
+  for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
+    const int node = *it, n = f.after[node];
+    double* x = v.data() + 6 * node;
+    const RodDampingSolve::GroupFactors& F = f.groupFactors[f.factorsOf[node]];
+    Quad x0 = times(F.Sinv[0], x, 0), x1 = times(F.Sinv[1], x, 1);
+    if (n >= 0) {
+      const RodDampingSolve::GroupFactors& Fn = f.groupFactors[f.factorsOf[n]];
+      x0 -= times(Fn.PT[0], v.data() + 6 * n, 0), x1 -= times(Fn.PT[1], v.data() + 6 * n, 1);
+    }
+    for (int k = 0; k < 3; ++k) x[kGroups[0][k]] = x0[k], x[kGroups[1][k]] = x1[k];
+  }
+}
+
 }  // namespace
 
+void solveRodDamping(const RodDampingSolve& f, const VecX& vStar, VecX& v) {
+  const int lanes = static_cast<int>(f.lanes.size());
+#pragma omp parallel for schedule(static, 1)
+  for (int lane = 0; lane < lanes; ++lane) {
+    const FlushSubnormals flush;
+    sweepForward(f, f.lanes[lane], vStar, v);
+    sweepBackward(f, f.lanes[lane], v);
+  }
+}
+
 RodDampingSolve factoriseRodDamping(const SpMat& K, const VecX& mass, const std::vector<int>& prescribedDofs,
-                                    const std::vector<int>& nodeRod, double scale, double c, int lanes) {
+                                    const std::vector<int>& nodeRod, double scale, double c) {
   RodDampingSolve f;
   f.scale = scale, f.c = c;
   const int nodes = static_cast<int>(mass.size() / 6);
@@ -156,12 +259,13 @@ RodDampingSolve factoriseRodDamping(const SpMat& K, const VecX& mass, const std:
   f.diag.assign(nodes, std::array<double, 6>{});
   const std::vector<char> prescribed = prescribedMask(static_cast<int>(mass.size()), prescribedDofs);
   factoriseNodes(K, mass, prescribed, f, [](int, bool, bool) { return true; });
+  splitFactorsByGroups(f);
   f.rhsScale = scale * mass;
   for (int dof : prescribedDofs) f.rhsScale[dof] = 1;
   collectGripCouplings(K, prescribedDofs, prescribed, f);
   // lanes: contiguous ranges of rod numbers
   const int rods = nodeRod.empty() ? 1 : *std::max_element(nodeRod.begin(), nodeRod.end()) + 1;
-  lanes = std::max(1, std::min(lanes, rods));
+  const int lanes = std::max(1, std::min(RodDampingSolve::kLanes, rods));
   f.lanes.assign(lanes, {});
   for (int node = 0; node < nodes; ++node)
     f.lanes[static_cast<long>(nodeRod[node]) * lanes / rods].push_back(node);
@@ -173,30 +277,9 @@ long refactoriseRodDamping(const SpMat& K, const VecX& mass, const std::vector<i
   const std::vector<char> prescribed = prescribedMask(static_cast<int>(mass.size()), prescribedDofs);
   const long count = factoriseNodes(K, mass, prescribed, f,
                                     [](int, bool changed, bool beforeRedone) { return changed || beforeRedone; });
+  splitFactorsByGroups(f);
   collectGripCouplings(K, prescribedDofs, prescribed, f);
   return count;
-}
-
-void solveRodDamping(const RodDampingSolve& f, VecX& v) {
-  for (const auto& g : f.gripColumns) v[g.freeDof] -= g.cK * v[g.gripDof] / f.rhsScale[g.freeDof];
-  const int lanes = static_cast<int>(f.lanes.size());
-#pragma omp parallel for schedule(static, 1)
-  for (int lane = 0; lane < lanes; ++lane) {
-    const std::vector<int>& nodes = f.lanes[lane];
-    for (int node : nodes) {  // forward: y_i = rhs_i - P_i y_p
-      auto y = v.segment<6>(6 * node);
-      y = f.rhsScale.segment<6>(6 * node).cwiseProduct(y);
-      if (f.before[node] >= 0) y.noalias() -= f.factors[f.factorsOf[node]].P * v.segment<6>(6 * f.before[node]);
-    }
-    for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {  // backward: v_i = S_i^-1 y_i - P_n^T v_n
-      const int node = *it;
-      const Vec6 y = v.segment<6>(6 * node);
-      auto x = v.segment<6>(6 * node);
-      x.noalias() = f.factors[f.factorsOf[node]].Sinv * y;
-      if (f.after[node] >= 0)
-        x.noalias() -= f.factors[f.factorsOf[f.after[node]]].P.transpose() * v.segment<6>(6 * f.after[node]);
-    }
-  }
 }
 
 void multiplyGripRows(const RodDampingSolve& f, const VecX& v, VecX& Kv) {
