@@ -22,10 +22,11 @@ from enamel_results import constants
 from enamel_results.constants import EXIT
 
 
-# Size convergence (docs/results.md): at the default interface ductility Gamma_i k/sigma0^2 = 9 and the default
-# tip reading (crisscross_at_tip = "cut") the theta30 R-curve is the same (enamel_results.metrics.same_rcurve) at
-# 80 x 80 d and 100 x 100 d; smaller specimens, any other G and the other reading are not shown converged.
-CONVERGED_SIZE_OVER_D = 80.0
+# Size convergence (docs/results.md): no specimen smaller than the paper's 200 x 200 d has been shown to give its
+# R-curve by the phase-averaged measure (at 80 and 100 d one configuration of theta30 (21.4, 10) is 12 and 10 % below
+# the 200 d run's), so only the paper's size is labelled size-converged: it is the size reference itself, at the
+# default G and tip reading.
+CONVERGED_SIZE_OVER_D = 200.0
 CONVERGED_H_E_OVER_D = 0.3
 CONVERGED_G = 9.0
 CONVERGED_TIP = "cut"
@@ -52,7 +53,7 @@ def convergence_label(results) -> str:
     gs = sorted({float(r.params["Gamma_k_over_sigma0sq"]) for r in rs})
     size_text = ", ".join(f"{w:g} x {h:g} d" for w, h in sizes)
     g_text = ", ".join(f"{g:g}" for g in gs)
-    return (f"NOT size-converged ({size_text}, G = {g_text}; converged from "
+    return (f"NOT size-converged ({size_text}, G = {g_text}; the size reference is "
             f"{CONVERGED_SIZE_OVER_D:g} x {CONVERGED_SIZE_OVER_D:g} d at G = {CONVERGED_G:g}, {CONVERGED_TIP} tip)")
 
 
