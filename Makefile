@@ -163,7 +163,7 @@ bench-paper: $(ENAMEL)
 
 # --- the pipeline: paper_cases/ -> runs/<preset>/<case>/result.h5 -> figures/out/<preset>/ ---------------
 # The solver binary is a file target, so runs depend on it: a rebuilt solver re-runs the cases.
-SOLVER_SOURCES := $(wildcard solver/lib/*.cpp solver/lib/*.hpp solver/lib/*/*.cpp solver/lib/*/*.hpp solver/app/*.cpp) CMakeLists.txt
+SOLVER_SOURCES := $(wildcard solver/lib/*/*.cpp solver/lib/*/*.hpp solver/app/*.cpp) CMakeLists.txt
 $(ENAMEL): $(SOLVER_SOURCES) | deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target enamel-dem
 

@@ -1,8 +1,8 @@
 """The numbers the Python side shares with the solver, as the solver itself prints them (`enamel-dem constants
---json`, solver/lib/shared_constants.cpp): each is defined once in C++ and read here from the binary that the
+--json`, solver/lib/run/shared_constants.cpp): each is defined once in C++ and read here from the binary that the
 tests and the pipeline run (ENAMEL_BINARY, else build/enamel-dem: enamel_results.paths), once per process.
 
-    EXIT          {name: exit status} (`EXIT["missing_file"]` = 3, ...; solver/lib/exit_codes.hpp)
+    EXIT          {name: exit status} (`EXIT["missing_file"]` = 3, ...; solver/lib/base/exit_codes.hpp)
     EXIT_MISSING  a file that is not there (a case file; the figure scripts' missing result)
     KINETIC_WARN  the kinetic/strain energy ratio above which a run is warned as not quasi-static (runner.hpp)
     BALANCE_WARN  |/history/energy_balance_error| above this at any row is warned (runner.hpp)

@@ -12,7 +12,7 @@ RECORD_SUFFIX = ".json"
 FIGURES_OUT = ROOT / "figures" / "out"
 SOLVER = ROOT / "build" / "enamel-dem"  # the solver binary (ENAMEL_BINARY overrides it)
 
-# The result files of a run directory, by status (solver/lib/output.cpp resultFileFor): result.h5 exists only for a
+# The result files of a run directory, by status (solver/lib/io/output.cpp resultFileFor): result.h5 exists only for a
 # completed run; a run in progress or interrupted has result.partial.h5, a failed one result.failed.h5.
 RESULT_NAMES = {"completed": "result.h5", "partial": "result.partial.h5", "failed": "result.failed.h5"}
 

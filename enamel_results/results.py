@@ -1,4 +1,4 @@
-"""Load one result.h5 written by enamel-dem (solver/lib/output.cpp defines the layout): /meta, /rcurve,
+"""Load one result.h5 written by enamel-dem (solver/lib/io/output.cpp defines the layout): /meta, /rcurve,
 /history, and with full=True /geometry and every /frames/<n>.
 
 Normalisation everywhere: crack advance Delta_a by the rod spacing d, crack resistance R by the interface
@@ -65,7 +65,7 @@ EXIT_DAMAGED = EXIT_CODES["result_damaged"]    # a result file is truncated or f
 
 @dataclasses.dataclass(frozen=True)
 class SealLayout:
-    """The seal enamel-dem writes at the start of the result file's HDF5 user block (solver/lib/output.hpp
+    """The seal enamel-dem writes at the start of the result file's HDF5 user block (solver/lib/io/output.hpp
     ResultSeal), as the solver declares it (enamel_results.constants.RESULT_SEAL): magic, format, CRC-32
     (zlib.crc32) of the whole file with the crc field's bytes as zeros, the file's size."""
     struct: struct.Struct       # the fields in order, little-endian, no padding
@@ -89,7 +89,7 @@ def seal_layout() -> SealLayout:
     return SealLayout(layout, seal["magic"].encode("ascii"), seal["format"], offsets["crc"], seal["userblock_bytes"])
 
 
-# Interface tags (/geometry/iface_tag; solver/lib/geometry.hpp InterfaceTag).
+# Interface tags (/geometry/iface_tag; solver/lib/geometry/geometry.hpp InterfaceTag).
 TAG_PLY1, TAG_PLY2, TAG_INTER12, TAG_INTER21 = 0, 1, 2, 3
 
 

@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
-"""The include layers of solver/lib (docs/contributing.md): each file may include only files of its own layer or
-a lower one. Reads every `#include "..."` line of solver/lib/**/*.{hpp,cpp} and solver/app/*.cpp; prints each
-include that goes up a layer (and each file missing from the table) and exits 1 if there is any, else prints
-how many includes it checked and exits 0. A file is named by its path under solver/lib without the suffix
-(`integrators/lumped`); an include is looked for beside the including file first, then under solver/lib.
-Standard library only: `python3 tools/check_layers.py`."""
+"""The include layers of solver/lib (docs/contributing.md). The layers are the folders of solver/lib, in the
+order of LAYERS below (lowest first), with the command line (solver/app) on top; a file's layer is its folder,
+and it may include only files of its own layer or a lower one. Every include of a library file names it by its
+path under solver/lib (`#include "laws/beam.hpp"`, the one include directory), so the include says its layer.
+
+Reads every `#include "..."` line of solver/lib/*/*.{hpp,cpp} and solver/app/*.cpp and prints each include that
+goes up a layer or names a library file by another path, each file outside a layer folder, each folder of
+solver/lib that is not in LAYERS and each layer without its folder; exits 1 if there is any, else prints how
+many includes it checked and exits 0. Standard library only: `python3 tools/check_layers.py [FILE...]`."""
 from __future__ import annotations
 
 import pathlib
@@ -13,76 +16,97 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
-# Lowest first. A file's layer is that of its name (foo.hpp and foo.cpp share one).
-LAYERS = [
-    ("base", ["version", "exit_codes", "errors", "git_hash", "file_io", "choices"]),
-    ("pointwise laws and input", ["beam", "cohesive", "strength", "case_params"]),
-    ("geometry", ["geometry", "far_field"]),
-    ("plain data", ["state", "step_timers"]),
-    ("loops over the data", ["kernels", "node_blocks", "loading_rate", "measurements", "static_solve"]),
-    ("schemes and set-up", ["integrators", "integrators/step_parts", "integrators/node_rows",
-                            "integrators/slice_outputs", "integrators/newmark", "integrators/lumped",
-                            "integrators/schemes", "integrators/registry", "setup"]),
-    ("the simulation", ["simulation", "resources"]),   # resources: estimates from blocks of the case's model
-    ("files and tools", ["output", "checkpoint", "profile"]),
-    ("the run", ["runner", "shared_constants"]),
-    ("the command line", ["enamel_dem"]),
-]
-LAYER_OF = {stem: i for i, (_, stems) in enumerate(LAYERS) for stem in stems}
+# The one definition of the layer order, lowest first: each name is a folder of solver/lib, except the last,
+# "app", the command line (solver/app).
+LAYERS = ["base", "laws", "case", "geometry", "data", "kernels", "integrators", "simulation", "io", "run", "app"]
+APP = "app"
+RANK = {name: i for i, name in enumerate(LAYERS)}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+SUFFIXES = (".hpp", ".cpp")
+
+
+def lib_of(root: pathlib.Path) -> pathlib.Path:
+    return root / "solver" / "lib"
 
 
 def sources(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
-    lib = root / "solver" / "lib"
-    return sorted([*lib.glob("**/*.hpp"), *lib.glob("**/*.cpp"), *root.glob("solver/app/*.cpp")])
+    lib = lib_of(root)
+    return sorted([*(f for f in lib.rglob("*") if f.suffix in SUFFIXES), *root.glob("solver/app/*.cpp")])
 
 
-def name_of(path: pathlib.Path) -> str:
-    """A file's name in the table: its path under solver/lib without the suffix, else its stem."""
-    lib = ROOT / "solver" / "lib"
+def layer_of(path: pathlib.Path, root: pathlib.Path = ROOT) -> str | None:
+    """A file's layer: its folder under solver/lib ("app" under solver/app); None for a file directly in
+    solver/lib or elsewhere."""
     path = path.resolve()
-    return path.relative_to(lib).with_suffix("").as_posix() if path.is_relative_to(lib) else path.stem
+    lib = lib_of(root).resolve()
+    if path.is_relative_to(lib):
+        parts = path.relative_to(lib).parts
+        return parts[0] if len(parts) > 1 else None
+    if path.parent == (root / "solver" / APP).resolve():
+        return APP
+    return None
 
 
-def included_name(including: pathlib.Path, include: str) -> str:
-    """The table name of `#include "include"` in file `including`: beside it first, then under solver/lib."""
-    for base in (including.parent, ROOT / "solver" / "lib"):
-        if (base / include).is_file():
-            return name_of(base / include)
-    return pathlib.PurePosixPath(include).with_suffix("").as_posix()
+def included_layer(including: pathlib.Path, include: str, root: pathlib.Path = ROOT) -> tuple[str | None, bool]:
+    """(layer of `#include "include"` in file `including`, whether the include names the file by its path under
+    solver/lib). Looked for as the compiler does, beside the including file first, then under solver/lib; an
+    include found nowhere is taken as a path under solver/lib (its first folder its layer)."""
+    beside = including.parent / include
+    if beside.is_file() and beside.resolve() != (lib_of(root) / include).resolve():
+        return layer_of(beside, root), False
+    parts = pathlib.PurePosixPath(include).parts
+    return (parts[0] if len(parts) > 1 else None), True
 
 
-def violations(files: list[pathlib.Path]) -> tuple[list[str], int]:
-    """(messages, number of includes checked)."""
+def tree_problems(root: pathlib.Path = ROOT) -> list[str]:
+    """Files directly in solver/lib, its folders that are not layers, and layers without their folder."""
+    lib = lib_of(root)
+    folders = {d.name for d in lib.iterdir() if d.is_dir()}
+    out = [f"solver/lib/{f.name}: not in a layer folder (move it into the folder of its layer)"
+           for f in sorted(lib.iterdir()) if f.is_file() and f.suffix in SUFFIXES]
+    out += [f"solver/lib/{d}/: not a layer (add it to LAYERS of tools/check_layers.py, in its place)"
+            for d in sorted(folders - set(LAYERS))]
+    out += [f"layer {name!r} of tools/check_layers.py has no folder solver/lib/{name}/"
+            for name in LAYERS if name != APP and name not in folders]
+    return out
+
+
+def violations(files: list[pathlib.Path], root: pathlib.Path = ROOT) -> tuple[list[str], int]:
+    """(messages, number of includes checked) for the includes of `files` (in the tree at `root`)."""
     out, checked = [], 0
     for f in files:
-        me = name_of(f)
-        if me not in LAYER_OF:
-            out.append(f"{f.name}: not in the layer table of tools/check_layers.py")
+        mine = layer_of(f, root)
+        if mine not in RANK:
+            out.append(f"{f.name}: not in a layer folder of solver/lib (tools/check_layers.py LAYERS)")
             continue
-        mine = LAYER_OF[me]
         for n, line in enumerate(f.read_text(errors="replace").splitlines(), 1):
             m = INCLUDE.match(line)
             if not m:
                 continue
             checked += 1
-            other = included_name(f, m[1])
-            if other not in LAYER_OF:
-                out.append(f"{f.name}:{n}: includes {m[1]}, which is not in the layer table")
-            elif LAYER_OF[other] > mine:
-                out.append(f"{f.name}:{n}: includes {m[1]} (layer {LAYER_OF[other]} {LAYERS[LAYER_OF[other]][0]!r}) "
-                           f"from layer {mine} {LAYERS[mine][0]!r}: an include from a lower layer to a higher one")
+            other, by_path = included_layer(f, m[1], root)
+            where = f"{mine}/{f.name}:{n}: includes {m[1]}"
+            if other not in RANK:
+                out.append(f"{where}, which is in no layer folder")
+            elif not by_path:
+                out.append(f"{where}: name it by its path under solver/lib ({other}/{pathlib.Path(m[1]).name})")
+            elif RANK[other] > RANK[mine]:
+                out.append(f"{where} (layer {RANK[other]} {other!r}) from layer {RANK[mine]} {mine!r}: "
+                           "an include from a lower layer to a higher one")
     return out, checked
 
 
 def main(argv: list[str]) -> int:
     files = [pathlib.Path(a) for a in argv] or sources()
     bad, checked = violations(files)
+    if not argv:
+        bad = tree_problems() + bad
     for b in bad:
         print(b)
     if bad:
         return 1
-    print(f"check_layers: {checked} includes in {len(files)} files, none from a lower layer to a higher one")
+    print(f"check_layers: {checked} includes in {len(files)} files, none from a lower layer to a higher one "
+          f"(layers: {' < '.join(LAYERS)})")
     return 0
 
 

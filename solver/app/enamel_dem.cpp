@@ -13,19 +13,19 @@
 #include <iostream>
 #include <memory>
 
-#include "beam.hpp"
-#include "case_params.hpp"
-#include "exit_codes.hpp"
-#include "file_io.hpp"
-#include "geometry.hpp"
-#include "integrators.hpp"
-#include "loading_rate.hpp"
-#include "profile.hpp"
-#include "resources.hpp"
-#include "runner.hpp"
-#include "shared_constants.hpp"
-#include "simulation.hpp"
-#include "version.hpp"
+#include "base/exit_codes.hpp"
+#include "base/version.hpp"
+#include "case/case_params.hpp"
+#include "geometry/geometry.hpp"
+#include "integrators/integrators.hpp"
+#include "io/file_io.hpp"
+#include "kernels/loading_rate.hpp"
+#include "laws/beam.hpp"
+#include "run/profile.hpp"
+#include "run/runner.hpp"
+#include "run/shared_constants.hpp"
+#include "simulation/resources.hpp"
+#include "simulation/simulation.hpp"
 
 namespace fs = std::filesystem;
 using namespace enamel;

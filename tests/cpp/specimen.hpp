@@ -1,6 +1,6 @@
 #pragma once
 // The tests' common specimen: w x h d at theta_D, pre-cracked to the middle, slices h_e = 0.3 d.
-#include "geometry.hpp"
+#include "geometry/geometry.hpp"
 
 inline enamel::GeometryParams specimen(double thetaDeg, double w, double h) {
   enamel::GeometryParams p;

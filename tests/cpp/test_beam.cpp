@@ -1,6 +1,6 @@
-// Tests for the 3D Euler-Bernoulli beam element (solver/lib/beam.hpp): physical invariants with stated
+// Tests for the 3D Euler-Bernoulli beam element (solver/lib/laws/beam.hpp): physical invariants with stated
 // tolerances, no mesh needed beyond a small dense cantilever assembled here.
-#include "beam.hpp"
+#include "laws/beam.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Case-file parsing: one test per error class (exit code + a message naming key, value, range),
 // the layering order, the key table's own consistency, and round-tripping the effective case.
-#include "case_params.hpp"
-#include "exit_codes.hpp"
-#include "loading_rate.hpp"
+#include "base/exit_codes.hpp"
+#include "case/case_params.hpp"
+#include "kernels/loading_rate.hpp"
 
 #include <gtest/gtest.h>
 

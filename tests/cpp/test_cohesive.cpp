@@ -1,5 +1,5 @@
-// Tests of the symmetric trapezoidal cohesive law and the rigid-arm interface element (solver/lib/cohesive).
-#include "cohesive.hpp"
+// Tests of the symmetric trapezoidal cohesive law and the rigid-arm interface element (solver/lib/laws/cohesive).
+#include "laws/cohesive.hpp"
 
 #include <gtest/gtest.h>
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "integrators.hpp"
-#include "simulation.hpp"
+#include "integrators/integrators.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace enamel;
 

@@ -10,9 +10,9 @@
 #include <map>
 #include <string>
 
-#include "far_field.hpp"
-#include "kernels.hpp"
-#include "simulation.hpp"
+#include "geometry/far_field.hpp"
+#include "kernels/kernels.hpp"
+#include "simulation/simulation.hpp"
 
 #include "specimen.hpp"
 

@@ -6,7 +6,7 @@
 #include <map>
 #include <set>
 
-#include "geometry.hpp"
+#include "geometry/geometry.hpp"
 
 using namespace enamel;
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <utility>
 
-#include "measurements.hpp"
-#include "simulation.hpp"
+#include "kernels/measurements.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace enamel;
 

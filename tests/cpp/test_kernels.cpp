@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "exit_codes.hpp"
-#include "kernels.hpp"
-#include "node_blocks.hpp"
-#include "runner.hpp"
-#include "simulation.hpp"
-#include "static_solve.hpp"
+#include "base/exit_codes.hpp"
+#include "kernels/kernels.hpp"
+#include "kernels/node_blocks.hpp"
+#include "kernels/static_solve.hpp"
+#include "run/runner.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace enamel;
 

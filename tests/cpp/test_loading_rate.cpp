@@ -7,7 +7,7 @@
 #include <cmath>
 #include <utility>
 
-#include "loading_rate.hpp"
+#include "kernels/loading_rate.hpp"
 
 using namespace enamel;
 

@@ -7,10 +7,10 @@
 #include <set>
 #include <tuple>
 
-#include "cohesive.hpp"
-#include "geometry.hpp"
-#include "measurements.hpp"
-#include "state.hpp"
+#include "data/state.hpp"
+#include "geometry/geometry.hpp"
+#include "kernels/measurements.hpp"
+#include "laws/cohesive.hpp"
 
 #include "specimen.hpp"
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "measurements.hpp"
-#include "runner.hpp"
+#include "kernels/measurements.hpp"
+#include "run/runner.hpp"
 
 using enamel::estimateTimeLeft;
 using enamel::formatTimeLeft;

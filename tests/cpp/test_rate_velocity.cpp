@@ -13,9 +13,9 @@
 #include <iostream>
 #include <string>
 
-#include "integrators.hpp"
-#include "loading_rate.hpp"
-#include "simulation.hpp"
+#include "integrators/integrators.hpp"
+#include "kernels/loading_rate.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace enamel;
 

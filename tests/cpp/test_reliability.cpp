@@ -9,9 +9,9 @@
 #include <fstream>
 #include <string>
 
-#include "case_params.hpp"
-#include "file_io.hpp"
-#include "runner.hpp"
+#include "case/case_params.hpp"
+#include "io/file_io.hpp"
+#include "run/runner.hpp"
 
 using namespace enamel;
 

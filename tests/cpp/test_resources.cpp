@@ -1,15 +1,15 @@
 // The run-time estimate (resources.hpp): the pure model's response to the keys that set a run's length and
 // cost, and the block's time step against the one of the model the case builds.
-#include "resources.hpp"
+#include "simulation/resources.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "case_params.hpp"
-#include "integrators.hpp"
-#include "simulation.hpp"
+#include "case/case_params.hpp"
+#include "integrators/integrators.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace enamel;
 

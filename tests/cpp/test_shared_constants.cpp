@@ -7,12 +7,12 @@
 
 #include <string>
 
-#include "case_params.hpp"
-#include "exit_codes.hpp"
-#include "loading_rate.hpp"
-#include "output.hpp"
-#include "runner.hpp"
-#include "shared_constants.hpp"
+#include "base/exit_codes.hpp"
+#include "case/case_params.hpp"
+#include "io/output.hpp"
+#include "kernels/loading_rate.hpp"
+#include "run/runner.hpp"
+#include "run/shared_constants.hpp"
 
 using namespace enamel;
 

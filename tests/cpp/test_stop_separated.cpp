@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "case_params.hpp"
-#include "runner.hpp"
+#include "case/case_params.hpp"
+#include "run/runner.hpp"
 
 using namespace enamel;
 

@@ -1,6 +1,6 @@
 // Rod-strength sampling: reproducible per seed, the right (truncated) normal statistics, no
 // negative strengths, and cv = 0 exact.
-#include "strength.hpp"
+#include "laws/strength.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "case_params.hpp"
-#include "setup.hpp"
+#include "case/case_params.hpp"
+#include "simulation/setup.hpp"
 
 using namespace enamel;
 

@@ -1,4 +1,4 @@
-// libFuzzer target for the case parser (solver/lib/case_params.hpp): `make fuzz`.
+// libFuzzer target for the case parser (solver/lib/case/case_params.hpp): `make fuzz`.
 //
 // Input: the bytes are a case file (TOML text) for parseCase, with two kinds of directive lines
 // taken out of the text first (so that they can carry any bytes) and blanked (line numbers stay):
@@ -12,8 +12,8 @@
 //   - a CaseError whose exitCode is not one of the case-error codes, or whose message is empty;
 //   - a broken round trip: case_params.hpp promises that parseCase(p.tomlText) gives the case back,
 //     so the effective TOML must parse again, with no preset and no --set, to the same key lines.
-#include "case_params.hpp"
-#include "exit_codes.hpp"
+#include "base/exit_codes.hpp"
+#include "case/case_params.hpp"
 
 #include <cstddef>
 #include <cstdint>

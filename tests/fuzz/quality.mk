@@ -24,7 +24,7 @@ FUZZ_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 120
 CLANGXX ?= clang++
 FUZZ_BIN := $(FUZZ_DIR)/fuzz_case_params
-FUZZ_SOURCES := tests/fuzz/fuzz_case_params.cpp solver/lib/case_params.cpp solver/lib/choices.cpp
+FUZZ_SOURCES := tests/fuzz/fuzz_case_params.cpp solver/lib/case/case_params.cpp solver/lib/base/choices.cpp
 FUZZ_CXXFLAGS := -std=c++17 -g -O1 -fno-omit-frame-pointer -D_GLIBCXX_ASSERTIONS \
   -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -Isolver/lib
 # toml++ 3.3.0 (Debian 12) has two known bugs that the fuzzer finds within seconds, and after which it
@@ -76,7 +76,7 @@ fuzz-check-clang:
 	  "(see $(FUZZ_DIR)/check_libfuzzer.log). Install the runtimes: apt-get install libclang-rt-dev" >&2; exit 1; }
 
 # Only the sources the parser needs; toml++ is used header-only here, so the fuzzer also covers its parser.
-$(FUZZ_BIN): $(FUZZ_SOURCES) solver/lib/case_params.hpp solver/lib/choices.hpp solver/lib/exit_codes.hpp $(FUZZ_HEADERS) \
+$(FUZZ_BIN): $(FUZZ_SOURCES) solver/lib/case/case_params.hpp solver/lib/base/choices.hpp solver/lib/base/exit_codes.hpp $(FUZZ_HEADERS) \
     tests/fuzz/quality.mk | deps fuzz-check-clang
 	$(CLANGXX) $(FUZZ_CXXFLAGS) $(FUZZ_SOURCES) -o $@
 

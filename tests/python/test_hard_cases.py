@@ -9,7 +9,7 @@ import pytest
 
 from conftest import ROOT
 
-# 2%: the runner's own warning level (solver/lib/runner.cpp kBalanceWarn); the measured errors are 1e-6..1e-3.
+# 2%: the runner's own warning level (solver/lib/run/runner.cpp kBalanceWarn); the measured errors are 1e-6..1e-3.
 BALANCE_BOUND = 0.02
 BASE = ROOT / "paper_cases" / "theta30_s21.4_e10_cv0.toml"
 THETA0_CASE = "theta0_s21.4_e10_cv0"  # BASE with theta_D = 0

@@ -17,33 +17,52 @@ def test_the_tree_has_no_include_from_a_lower_layer_to_a_higher_one():
     assert "none from a lower layer to a higher one" in r.stdout
 
 
+def test_the_layers_are_the_folders_of_solver_lib():
+    # one folder per layer, in the list's order, the command line on top; no file outside them
+    lib = ROOT / "solver" / "lib"
+    assert sorted(d.name for d in lib.iterdir() if d.is_dir()) == sorted(check_layers.LAYERS[:-1])
+    assert check_layers.LAYERS[-1] == "app" and check_layers.tree_problems() == []
+    assert [f.name for f in lib.iterdir() if f.is_file()] == []
+    lumped = lib / "integrators" / "lumped.cpp"
+    assert check_layers.layer_of(lumped) == "integrators" and lumped in check_layers.sources()
+    assert check_layers.layer_of(ROOT / "solver" / "app" / "enamel_dem.cpp") == "app"
+    assert check_layers.included_layer(lumped, "kernels/kernels.hpp") == ("kernels", True)
+
+
+def plant(root, path, text):
+    f = root / "solver" / "lib" / path
+    f.parent.mkdir(parents=True, exist_ok=True)
+    f.write_text(text)
+    return f
+
+
 def test_an_include_up_a_layer_is_caught(tmp_path):
-    # node_blocks.cpp once included integrators.hpp (a layer above it) for SolverError
-    bad = tmp_path / "node_blocks.cpp"
-    bad.write_text('#include "node_blocks.hpp"\n#include "integrators.hpp"\n')
-    found, checked = check_layers.violations([bad])
-    assert checked == 2
-    assert len(found) == 1 and "integrators.hpp" in found[0] and "lower layer to a higher one" in found[0]
-    unknown = tmp_path / "newfile.cpp"
-    unknown.write_text('#include "state.hpp"\n')
-    assert "not in the layer table" in check_layers.violations([unknown])[0][0]
+    # node_blocks.cpp (kernels) once included integrators.hpp (a layer above it) for SolverError
+    plant(tmp_path, "integrators/integrators.hpp", "#pragma once\n")
+    bad = plant(tmp_path, "kernels/node_blocks.cpp",
+                '#include "kernels/node_blocks.hpp"\n#include "base/errors.hpp"\n#include "integrators/integrators.hpp"\n')
+    found, checked = check_layers.violations([bad], root=tmp_path)
+    assert checked == 3
+    assert len(found) == 1 and "integrators/integrators.hpp" in found[0] and "lower layer to a higher one" in found[0]
+    assert "(layer 6 'integrators') from layer 5 'kernels'" in found[0]
+    # the same file one layer up passes
+    ok = plant(tmp_path, "integrators/node_blocks.cpp", bad.read_text())
+    assert check_layers.violations([ok], root=tmp_path) == ([], 3)
 
 
-def test_files_under_solver_lib_folders_are_named_by_their_path():
-    # the integrators' folder: its files include each other by their bare names and the library's by theirs
-    lumped = ROOT / "solver" / "lib" / "integrators" / "lumped.cpp"
-    assert check_layers.name_of(lumped) == "integrators/lumped"
-    assert check_layers.included_name(lumped, "node_rows.hpp") == "integrators/node_rows"
-    assert check_layers.included_name(lumped, "kernels.hpp") == "kernels"
-    assert lumped in check_layers.sources()
-
-
-def test_an_include_up_into_a_folder_is_caught(tmp_path):
-    bad = tmp_path / "kernels.cpp"  # layer 4 reaching into the schemes (layer 5)
-    bad.write_text('#include "kernels.hpp"\n#include "integrators/node_rows.hpp"\n')
-    found, checked = check_layers.violations([bad])
-    assert checked == 2
-    assert len(found) == 1 and "integrators/node_rows.hpp" in found[0] and "lower layer to a higher one" in found[0]
+def test_a_file_outside_the_layers_and_an_include_without_its_folder_are_caught(tmp_path):
+    beside = plant(tmp_path, "kernels/node_blocks.hpp", "#pragma once\n")
+    bare = plant(tmp_path, "kernels/kernels.cpp", '#include "node_blocks.hpp"\n#include "state.hpp"\n')
+    found, _ = check_layers.violations([bare], root=tmp_path)
+    assert len(found) == 2 and "kernels/node_blocks.hpp" in found[0] and "in no layer folder" in found[1]
+    loose = plant(tmp_path, "newfile.cpp", '#include "data/state.hpp"\n')
+    stray = plant(tmp_path, "misc/newfile.cpp", '#include "data/state.hpp"\n')
+    assert all("not in a layer folder" in m for m in check_layers.violations([loose, stray], root=tmp_path)[0])
+    problems = check_layers.tree_problems(tmp_path)
+    assert "solver/lib/newfile.cpp: not in a layer folder (move it into the folder of its layer)" in problems
+    assert any(p.startswith("solver/lib/misc/: not a layer") for p in problems)
+    assert any("layer 'base'" in p and "has no folder" for p in problems)
+    assert beside.is_file()
 
 
 def test_no_function_in_solver_is_over_80_lines():

@@ -1,4 +1,4 @@
-"""Adaptive loading rate (case key rate_adapt_max, solver/lib/loading_rate.hpp):
+"""Adaptive loading rate (case key rate_adapt_max, solver/lib/kernels/loading_rate.hpp):
 a ci-size lumped run with rate_adapt_max = 8 raises the rate multiplier phi (/history/rate_multiplier) above 1
 while the specimen loads elastically, so the grips move faster than v_app on average; every history interval
 follows the rule (a rise x1.25 while elastic and rho = (kinetic energy beyond the loading's motion)/strain < rho_lo, a halving after rho > rho_hi or a

@@ -1,5 +1,5 @@
 """The adaptive rate's margin rule (rate_adapt_rule = "margin") and its velocity correction (rate_adapt_velocity =
-"quasi_static"; solver/lib/loading_rate.hpp, docs/solver.md, Adaptive loading rate) on ci runs of theta30 (the ci
+"quasi_static"; solver/lib/kernels/loading_rate.hpp, docs/solver.md, Adaptive loading rate) on ci runs of theta30 (the ci
 preset's full run at G = 10 with the intact tip, pinned in ci(): rods break there; at the default, G = 9 and the
 cut tip, the first rod break of margin8 does fall at phi = 1, measured):
 

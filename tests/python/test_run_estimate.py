@@ -1,4 +1,4 @@
-"""`enamel-dem info --estimate`'s time of a run (solver/lib/resources.cpp) against the solver's own numbers: the
+"""`enamel-dem info --estimate`'s time of a run (solver/lib/simulation/resources.cpp) against the solver's own numbers: the
 time step of its 16 x 8 d block against the one of the model `info` builds at the reduced size, and the steps of
 the whole run against real ci runs (/meta steps). The U_end constants were measured on the ci run of
 theta30_s21.4_e10_cv0; theta0_s21.4_e10_cv0 (another decussation angle, another c_d and dt) was not used."""

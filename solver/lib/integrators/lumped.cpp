@@ -13,12 +13,12 @@
 #include <omp.h>
 #endif
 
-#include "kernels.hpp"
-#include "node_rows.hpp"
-#include "rod_damping.hpp"
-#include "schemes.hpp"
-#include "slice_outputs.hpp"
-#include "step_parts.hpp"
+#include "integrators/node_rows.hpp"
+#include "integrators/rod_damping.hpp"
+#include "integrators/schemes.hpp"
+#include "integrators/slice_outputs.hpp"
+#include "integrators/step_parts.hpp"
+#include "kernels/kernels.hpp"
 
 namespace enamel {
 

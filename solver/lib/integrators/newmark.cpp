@@ -9,9 +9,9 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
 
-#include "kernels.hpp"
-#include "schemes.hpp"
-#include "step_parts.hpp"
+#include "integrators/schemes.hpp"
+#include "integrators/step_parts.hpp"
+#include "kernels/kernels.hpp"
 
 namespace enamel {
 

@@ -3,7 +3,7 @@
 // registers, broadcasts folded into the multiply-adds), x86-64-v3 (AVX2, FMA) or the default x86-64. The v4 and v3
 // copies give the same bits; the default differs from them by round-off (FMA rounds a * b + c once); one CPU gives
 // the same bits at any thread count.
-#include "node_rows.hpp"
+#include "integrators/node_rows.hpp"
 
 #include <array>
 #include <map>

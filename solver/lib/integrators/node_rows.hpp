@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "node_blocks.hpp"
-#include "state.hpp"
+#include "data/state.hpp"
+#include "kernels/node_blocks.hpp"
 
 namespace enamel {
 

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "integrators.hpp"
-#include "schemes.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/schemes.hpp"
 
 namespace enamel {
 

@@ -1,13 +1,13 @@
 // The rods' damping b K taken implicitly in the lumped step (rod_damping.hpp): the block factorisation of
 // H = s M + c K along each rod, and its solve.
-#include "rod_damping.hpp"
+#include "integrators/rod_damping.hpp"
 
 #include <algorithm>
 #include <cstring>
 #include <map>
 #include <sstream>
 
-#include "errors.hpp"
+#include "base/errors.hpp"
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>

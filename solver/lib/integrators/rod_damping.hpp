@@ -16,7 +16,7 @@
 #include <array>
 #include <vector>
 
-#include "state.hpp"
+#include "data/state.hpp"
 
 namespace enamel {
 

@@ -2,7 +2,7 @@
 // The factory of each scheme, one per file of solver/lib/integrators/ (registry.cpp lists them by name).
 #include <memory>
 
-#include "integrators.hpp"
+#include "integrators/integrators.hpp"
 
 namespace enamel {
 

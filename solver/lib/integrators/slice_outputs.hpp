@@ -9,8 +9,8 @@
 #include <omp.h>
 #endif
 
-#include "node_blocks.hpp"
-#include "state.hpp"
+#include "data/state.hpp"
+#include "kernels/node_blocks.hpp"
 
 namespace enamel {
 

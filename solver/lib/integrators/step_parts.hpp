@@ -1,8 +1,8 @@
 #pragma once
 // Pieces of a step that every scheme uses (the clock, the grips' entries, their power and work): inline, so that
 // each scheme's step compiles them as its own.
-#include "loading_rate.hpp"
-#include "state.hpp"
+#include "data/state.hpp"
+#include "kernels/loading_rate.hpp"
 
 namespace enamel {
 
