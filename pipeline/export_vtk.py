@@ -18,7 +18,7 @@ Two series, both in the reference configuration (apply "Warp By Vector" with `di
               2 failed), tag (0 ply 1, 1 ply 2, 2 interlayer 1-2, 3 interlayer 2-1), area (d^2), opening (the
               solver's relative displacement of the two faces at the cohesive point, d). point data:
               displacement of each corner: the mean of the two faces' rigid-arm motions, u + theta x (corner - node)
-              for node A and for node B (the solver's linearised kinematics, solver/lib/laws/cohesive.cpp).
+              for node A and for node B (the solver's linearised kinematics, solver/lib/geometry/cohesive.cpp).
               The quads keep z unwrapped from node A: interlayer 2-1 faces sit between z = t and z = B.
 Lengths in d, stresses in sigma0. Time value of each point: the frame's crack advance Delta_a/d (frames that
 repeat the state of the previous one, same solver step, are skipped; if the advances are not strictly

@@ -1,5 +1,7 @@
-// Tests of the symmetric trapezoidal cohesive law and the rigid-arm interface element (solver/lib/laws/cohesive).
-#include "laws/cohesive.hpp"
+// Tests of the symmetric trapezoidal cohesive law (solver/lib/laws/cohesive_law) and the rigid-arm interface
+// element (solver/lib/geometry/cohesive).
+#include "geometry/cohesive.hpp"
+#include "laws/cohesive_law.hpp"
 
 #include <gtest/gtest.h>
 

@@ -10,7 +10,7 @@
 #include "data/state.hpp"
 #include "geometry/geometry.hpp"
 #include "kernels/measurements.hpp"
-#include "laws/cohesive.hpp"
+#include "laws/cohesive_law.hpp"
 
 #include "specimen.hpp"
 

@@ -14,9 +14,10 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 
+#include "geometry/cohesive.hpp"
 #include "geometry/geometry.hpp"
 #include "laws/beam.hpp"
-#include "laws/cohesive.hpp"
+#include "laws/cohesive_law.hpp"
 
 namespace enamel {
 

@@ -17,7 +17,7 @@
 
 #include <Eigen/Dense>
 
-#include "laws/cohesive.hpp"
+#include "geometry/cohesive.hpp"
 
 namespace enamel {
 

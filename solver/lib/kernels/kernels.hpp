@@ -43,7 +43,7 @@ int computeForcesForInterfaces(const Model& m, const cohesive::Law& law, const O
 
 /// The lumped step's schedule of the interface law. An interface on the elastic branch (secantStiffness = k)
 /// exerts cohesive::elasticForceOnB, linear in its DOFs; the law (cohesive::computeTraction) is needed only to
-/// notice it leave its elastic track (cohesive.hpp), and it cannot while its effective separation lambda stays
+/// notice it leave its elastic track (cohesive_law.hpp), and it cannot while its effective separation lambda stays
 /// below (1 - kInterfaceScheduleMargin) lambdaTrack (lambdaTrack = sqrt(kElasticTrack) delta0; lambda of the
 /// mixed-mode law, cohesive::effectiveSeparation(law, .)). lambda moves by at most c |q change|_inf,
 /// c = max(1, 1/beta) sqrt(3) (2 + |rA,y| + |rA,z| + |rB,y| + |rB,z|) (lambda is max(1, 1/beta)-Lipschitz in the

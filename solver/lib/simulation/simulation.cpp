@@ -81,7 +81,7 @@ StaticStart Simulation::startFromStaticElastic(double fraction) {
   st.displacement = fraction * st.firstDamageDisplacement;
   st.time = materials.loading.timeOfDisplacement(st.displacement);
   setQuasiStaticState(ops, materials.loading, q1, reaction1, st.displacement, st.time, state);
-  // each interface's history at its current (elastic) separation (recorded only near delta0: cohesive.hpp)
+  // each interface's history at its current (elastic) separation (recorded only near delta0: cohesive_law.hpp)
   VecX f;
   state.failedInterfaces = computeForcesForInterfaces(model, materials.law, ops, state.q, state.lambdaMax, true, f);
   integrator->initialise(model, materials, ops, state);
