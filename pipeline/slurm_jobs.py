@@ -176,7 +176,7 @@ echo "figures $figures:" {then} "once every task of $array has succeeded; log $h
 """
 
 
-def main(argv=None) -> int:
+def parse_args(argv):
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--preset", required=True, help="preset of the runs (ci, reduced, converged, paper)")
     ap.add_argument("--cases", nargs="*", metavar="RUN", default=None,
@@ -204,17 +204,13 @@ def main(argv=None) -> int:
                     help="another #SBATCH option for both jobs (repeatable), e.g. --sbatch=--qos=long")
     ap.add_argument("--signal-seconds", type=int, default=300,
                     help="SIGUSR1 this many seconds before the time limit: checkpoint and requeue (default 300)")
-    a = ap.parse_args(argv)
+    return ap.parse_args(argv)
 
-    runs = select_runs(a.cases)
-    out = (a.out or pathlib.Path(a.runs) / a.preset / "slurm").resolve()
-    run_set = a.run_set.split()
-    make_vars = [f"PRESET={a.preset}", f"RUNS={a.runs}", *([f"RUN_SET={a.run_set}"] if run_set else []),
-                 f"LOCK_WAIT={LOCK_WAIT_S}", *a.make_var]   # a later --make-var LOCK_WAIT=... wins
-    make = f"make --no-print-directory -o {shlex.quote(str(a.solver))} {quote_vars(make_vars)}"
 
+def request_resources(a, runs: list, run_set: list) -> list:
+    """Fills a.mem and a.time from the solver's estimates where they were not given; returns what it chose, one
+    note each. With both given, one estimate is still made: it checks the solver, the preset and RUN_SET."""
     note = []
-    # the estimates (with --mem and --time given, one: it checks the solver, the preset and RUN_SET)
     try:
         with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 2) as pool:
             todo = runs if a.mem is None or a.time is None else runs[:1]
@@ -229,10 +225,11 @@ def main(argv=None) -> int:
         s = max(e["seconds"] for e in est.values())
         a.time = slurm_time(min(TIME_MAX_S, max(TIME_MIN_S, TIME_FACTOR * s)))
         note.append(f"--time {a.time} (solver estimate {s / 3600:.2g} h on one core, longest run)")
+    return note
 
-    common = {"partition": a.partition, "account": a.account}
-    common = {k: v for k, v in common.items() if v}
-    extra = "".join(f"#SBATCH {o}\n" for o in a.sbatch)
+
+def write_runs_job(a, runs: list, out: pathlib.Path, make: str, common: dict, extra: str, header: str) -> None:
+    """OUT/runs.sbatch: the job array, one task per run."""
     logs = out / "logs"
     targets = [str(paths.result_file(a.preset, case_of(r), r.endswith("_slow"), runs=pathlib.Path(a.runs)))
                for r in runs]
@@ -240,27 +237,46 @@ def main(argv=None) -> int:
              "output": str(logs / "run-%A_%a.out"), "open-mode": "append", "requeue": None,
              "signal": f"B:USR1@{a.signal_seconds}", "cpus-per-task": a.cpus, "mem": a.mem, "time": a.time,
              **common}
-    header = (f"#!/bin/bash\n# Written by pipeline/slurm_jobs.py: preset {a.preset}, {len(runs)} runs; "
-              f"submit with {out / 'submit.sh'}\n")
     body = ARRAY_BODY.format(targets="".join(f"  {shlex.quote(t)}   # task {i}\n" for i, t in enumerate(targets)),
                              make=make, signal_s=a.signal_seconds, locked=EXIT["output_locked"])
     out.mkdir(parents=True, exist_ok=True)
     logs.mkdir(exist_ok=True)
     (out / "runs.sbatch").write_text(header + sbatch_lines(array) + extra + body)
 
+
+def write_figures_job(a, out: pathlib.Path, make: str, common: dict, extra: str, header: str) -> str:
+    """OUT/figures.sbatch, the job after the array (none with --then none, or with --cases and no --then; an
+    older one is removed); returns its part of submit.sh ("" without it)."""
     then = a.then if a.then is not None else ("none" if a.cases is not None else f"{make} figures-all")
-    figures_part = ""
-    if then != "none":
-        fig = {"job-name": f"enamel-{a.preset}-figures", "chdir": str(paths.ROOT),
-               "output": str(logs / "figures-%j.out"), "kill-on-invalid-dep": "yes", "cpus-per-task": 1,
-               "mem": a.figures_mem, "time": a.figures_time, **common}
-        (out / "figures.sbatch").write_text(
-            header + sbatch_lines(fig) + extra +
-            f'\necho "$(date \'+%F %T\') figures (job $SLURM_JOB_ID) on $(hostname):" {shlex.quote(then)}\n{then}\n'
-            'rc=$?\necho "$(date \'+%F %T\') figures: exit status $rc"\nexit $rc\n')
-        figures_part = SUBMIT_FIGURES.format(then=shlex.quote(then))
-    else:
+    if then == "none":
         (out / "figures.sbatch").unlink(missing_ok=True)
+        return ""
+    fig = {"job-name": f"enamel-{a.preset}-figures", "chdir": str(paths.ROOT),
+           "output": str(out / "logs" / "figures-%j.out"), "kill-on-invalid-dep": "yes", "cpus-per-task": 1,
+           "mem": a.figures_mem, "time": a.figures_time, **common}
+    (out / "figures.sbatch").write_text(
+        header + sbatch_lines(fig) + extra +
+        f'\necho "$(date \'+%F %T\') figures (job $SLURM_JOB_ID) on $(hostname):" {shlex.quote(then)}\n{then}\n'
+        'rc=$?\necho "$(date \'+%F %T\') figures: exit status $rc"\nexit $rc\n')
+    return SUBMIT_FIGURES.format(then=shlex.quote(then))
+
+
+def main(argv=None) -> int:
+    a = parse_args(argv)
+    runs = select_runs(a.cases)
+    out = (a.out or pathlib.Path(a.runs) / a.preset / "slurm").resolve()
+    run_set = a.run_set.split()
+    make_vars = [f"PRESET={a.preset}", f"RUNS={a.runs}", *([f"RUN_SET={a.run_set}"] if run_set else []),
+                 f"LOCK_WAIT={LOCK_WAIT_S}", *a.make_var]   # a later --make-var LOCK_WAIT=... wins
+    make = f"make --no-print-directory -o {shlex.quote(str(a.solver))} {quote_vars(make_vars)}"
+    note = request_resources(a, runs, run_set)
+
+    common = {k: v for k, v in {"partition": a.partition, "account": a.account}.items() if v}
+    extra = "".join(f"#SBATCH {o}\n" for o in a.sbatch)
+    header = (f"#!/bin/bash\n# Written by pipeline/slurm_jobs.py: preset {a.preset}, {len(runs)} runs; "
+              f"submit with {out / 'submit.sh'}\n")
+    write_runs_job(a, runs, out, make, common, extra, header)
+    figures_part = write_figures_job(a, out, make, common, extra, header)
     submit = out / "submit.sh"
     submit.write_text(SUBMIT.format(preset=a.preset, n=len(runs), figures=figures_part))
     submit.chmod(0o755)

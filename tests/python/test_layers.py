@@ -1,11 +1,12 @@
 """The solver library's structure (docs/contributing.md): no include from a lower layer to a higher one
-(tools/check_layers.py) and no function over 80 lines (tools/check_function_length.py), each checked on the
-tree and each tool shown to catch what it is for on a file made to break it."""
+(tools/check_layers.py) and no function over 80 lines, in the solver (tools/check_function_length.py) or in the
+product's Python (tools/check_python_function_length.py), each checked on the tree and each tool shown to catch
+what it is for on a file made to break it."""
 import subprocess
 import sys
 
 from conftest import ROOT
-from tools import check_function_length, check_layers
+from tools import check_function_length, check_layers, check_python_function_length
 
 # Functions still over the limit, in files being reworked in parallel (to be split there, then removed here).
 STILL_LONG: set = set()   # (file, function) allowed over the limit: none
@@ -79,6 +80,33 @@ def test_a_long_function_is_caught(tmp_path):
                    "}  // namespace enamel\n")
     found = check_function_length.long_functions(src, 80)
     assert [(name, n) for _, name, n in found] == [("longOne", 88)]
+
+
+def test_no_function_of_the_products_python_is_over_80_lines():
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "check_python_function_length.py")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    files = check_python_function_length.product_files()
+    assert ROOT / "pipeline" / "slurm_jobs.py" in files and ROOT / "tools" / "check_layers.py" in files
+    from tools.check_notebook import NOTEBOOK   # tests and the lab notebook are not the product
+    assert not any({"tests", NOTEBOOK} & set(f.relative_to(ROOT).parts) for f in files)
+
+
+def test_a_long_python_function_is_caught(tmp_path):
+    body = "\n".join(f"        x += {i}" for i in range(80))
+    src = tmp_path / "jobs.py"
+    src.write_text("import sys\n\n\ndef short(x):\n    return x\n\n\n"
+                   f"class Jobs:\n    @staticmethod\n    def write(x):\n        \"\"\"Long.\"\"\"\n{body}\n        return x\n\n\n"
+                   "def main():\n    def inner(y):\n" + "        y += 1\n" * 78 + "        return y\n    return inner(1)\n")
+    found = check_python_function_length.long_functions(src, 80)
+    # a method by its class; a nested function counts in its outer one and is measured itself
+    assert [(name, n) for _, name, n in found] == [("Jobs.write", 83), ("main", 82)]
+    assert src.read_text().splitlines()[found[0][0] - 1].strip() == "def write(x):"
+    assert [(name, n) for _, name, n in check_python_function_length.long_functions(src, 79)] == [
+        ("Jobs.write", 83), ("main", 82), ("main.inner", 80)]
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "check_python_function_length.py"), str(src)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "jobs.py:10: Jobs.write (83 lines)" in r.stdout
 
 
 def test_the_product_never_depends_on_the_notebook():
