@@ -95,6 +95,25 @@ def record(preset: str) -> list[dict]:
     return list(old.values())
 
 
+BENCH = paths.ROOT / "bench" / "results.csv"
+
+
+def bench_paper(preset: str, case: str, rows: dict) -> dict | None:
+    """`paper` at `reduced` from the bench's record (bench/results.csv: its run of ~2 h per case), where this study's
+    capped run repeats the bench's `lumped cap0.5 dt0.22` run (the same R_init and R_ss to 1e-5): R_init, R_ss and rods
+    as recorded, the mean as the capped run's over (1 + the bench's relative difference of that variant)."""
+    capped = rows.get((case, "capped"))
+    if preset != "reduced" or not capped or not BENCH.is_file():
+        return None
+    bench = {(r["case"], r["variant"]): r for r in csv.DictReader(open(BENCH))}
+    paper, lumped = bench.get((case, "paper")), bench.get((case, "lumped cap0.5 dt0.22"))
+    if not paper or not lumped or abs(float(lumped["R_init"]) - float(capped["R_init"])) > 1e-5:
+        return None
+    mean = float(capped["R_mean"]) / (1 + float(lumped["R_mean_rel_diff"]))
+    return {"case": case, "scheme": "paper (bench record)", "R_init": paper["R_init"], "R_mean": mean,
+            "broken_rods": paper["broken_rods"], "da_first_rod": "nan", "wall_s": paper["wall_s"]}
+
+
 def pct(x: float) -> str:
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:+.1f} %"
 
@@ -109,11 +128,19 @@ def report(preset: str) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     for case in CASES:
         ref = rows.get((case, "paper"))
+        recorded = None if ref else bench_paper(preset, case, rows)
+        if recorded:
+            lines.append(f"| {case} | {recorded['scheme']} | {float(recorded['R_init']):.3f} | "
+                         f"{recorded['R_mean']:.3f} | {recorded['broken_rods']} | n/a | | | "
+                         f"{float(recorded['wall_s']):.0f} |")
         for scheme in SCHEMES:
             r = rows.get((case, scheme))
             if not r:
                 continue
             d_init = d_mean = None
+            if recorded and scheme != "paper":
+                d_init = float(r["R_init"]) / float(recorded["R_init"]) - 1
+                d_mean = float(r["R_mean"]) / recorded["R_mean"] - 1
             if ref and scheme != "paper":
                 a = metrics.rcurve_of(results.load_result(run_dir(preset, case, "paper") / paths.RESULT_NAMES["completed"], case))
                 b = metrics.rcurve_of(results.load_result(run_dir(preset, case, scheme) / paths.RESULT_NAMES["completed"], case))
