@@ -35,10 +35,8 @@ DATE = re.compile(r"(?<![\d.])(19|20)\d\d-(0[1-9]|1[0-2])-(0[1-9]|[12]\d|3[01])(
 HISTORY = re.compile(r"\b(before|since|until|till|as of)\s+(19|20)\d\d\b(?![.,]\d)"
                      r"(?!\s*(d|s|ms|min|h|k|M|x|%|rows?|steps?|runs?|rods?|DOF|nodes?|elements?)\b)", re.IGNORECASE)
 SELF = pathlib.Path(__file__).resolve()   # its ALLOWED lines may name the dates they allow
-# (file, text on the line): a test's input data, not history; and a line of docs/solver.md's paragraph on the
-# ringing and the damping, which is being rewritten where it stands (remove the entry once its date is gone)
+# (file, text on the line): a test's input data, not history
 ALLOWED = {
-    ("docs/solver.md", "What that ringing is ("),
     ("tests/python/test_records.py", '"written_utc"] = "2000-01-01T00:00:00Z"'),
 }
 
