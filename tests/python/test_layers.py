@@ -41,7 +41,8 @@ def test_an_include_up_a_layer_is_caught(tmp_path):
     # node_blocks.cpp (kernels) once included integrators.hpp (a layer above it) for SolverError
     plant(tmp_path, "integrators/integrators.hpp", "#pragma once\n")
     bad = plant(tmp_path, "kernels/node_blocks.cpp",
-                '#include "kernels/node_blocks.hpp"\n#include "base/errors.hpp"\n#include "integrators/integrators.hpp"\n')
+                '#include "kernels/node_blocks.hpp"\n#include "base/errors.hpp"\n'
+                '#include "integrators/integrators.hpp"\n')
     found, checked = check_layers.violations([bad], root=tmp_path)
     assert checked == 3
     assert len(found) == 1 and "integrators/integrators.hpp" in found[0] and "lower layer to a higher one" in found[0]
@@ -96,8 +97,10 @@ def test_a_long_python_function_is_caught(tmp_path):
     body = "\n".join(f"        x += {i}" for i in range(80))
     src = tmp_path / "jobs.py"
     src.write_text("import sys\n\n\ndef short(x):\n    return x\n\n\n"
-                   f"class Jobs:\n    @staticmethod\n    def write(x):\n        \"\"\"Long.\"\"\"\n{body}\n        return x\n\n\n"
-                   "def main():\n    def inner(y):\n" + "        y += 1\n" * 78 + "        return y\n    return inner(1)\n")
+                   "class Jobs:\n    @staticmethod\n    def write(x):\n        \"\"\"Long.\"\"\"\n"
+                   f"{body}\n        return x\n\n\n"
+                   "def main():\n    def inner(y):\n" + "        y += 1\n" * 78
+                   + "        return y\n    return inner(1)\n")
     found = check_python_function_length.long_functions(src, 80)
     # a method by its class; a nested function counts in its outer one and is measured itself
     assert [(name, n) for _, name, n in found] == [("Jobs.write", 83), ("main", 82)]
