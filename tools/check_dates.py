@@ -1,9 +1,10 @@
 """The product says what is: no hand-written product file carries a calendar date or a history phrase. When a
-thing changed, and what was true before, is git log's; dated measurements are the lab notebook's (research/) and
+thing changed, and what was true before, is git log's; dated measurements are the lab notebook's (its folder:
+tools/check_notebook.py's NOTEBOOK) and
 the data files' (a bench's CSV, a run's JSON record), which carry their date, machine and solver commit.
 
 Checked: every tracked file (git ls-files) but
-- the lab notebook, research/ (its diaries keep their dates);
+- the lab notebook (its diaries keep their dates);
 - data and figures, by suffix (DATA_SUFFIXES: .csv, .json, .h5, .png, .pdf, .svg, the fuzzer's .dict, ...);
 - the tests' reference data, tests/reference/;
 - CITATION.cff (its date-released is the release's date, a value);
@@ -23,7 +24,10 @@ import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-NOTEBOOK = "research"
+try:  # the notebook's folder, named once: imported as tools.check_dates, or run as a script from tools/
+    from tools.check_notebook import NOTEBOOK
+except ImportError:
+    from check_notebook import NOTEBOOK
 EXEMPT_DIRS = (NOTEBOOK, "tests/reference")
 EXEMPT_FILES = {"CITATION.cff"}
 DATA_SUFFIXES = {".csv", ".json", ".h5", ".hdf5", ".png", ".pdf", ".svg", ".jpg", ".jpeg", ".gif", ".npz", ".npy",

@@ -35,7 +35,7 @@ def test_a_planted_date_is_caught_with_its_file_and_line(tmp_path):
 def test_a_dated_folder_of_the_notebook_named_in_the_product_is_caught(tmp_path):
     doc = tmp_path / "docs" / "solver.md"
     doc.parent.mkdir()
-    doc.write_text(f"Measured in research/bench_experiments/chunks_{DAY}/.\n")
+    doc.write_text(f"Measured in {check_dates.NOTEBOOK}/bench_experiments/chunks_{DAY}/.\n")
     assert [f.split(":")[:2] for f in check_dates.violations([doc], root=tmp_path)] == [["docs/solver.md", "1"]]
 
 
@@ -49,7 +49,7 @@ def test_counts_and_plain_numbers_are_not_history(tmp_path):
 def test_the_notebook_data_generated_reports_and_reference_data_may_carry_dates(tmp_path):
     line = f"Run of {DAY}, solver abc1234.\n"
     files = {
-        "research/square/README.md": line,             # the notebook keeps its dates
+        f"{check_dates.NOTEBOOK}/square/README.md": line,             # the notebook keeps its dates
         "bench/results.csv": f"date\n{DAY}\n",         # data, by suffix
         "records/converged/x.json": f'{{"date": "{DAY}"}}\n',
         "tests/reference/ci/theta0.txt": line,         # the tests' reference data
