@@ -194,7 +194,6 @@ template <> hid_t nativeType<float>() { return H5T_NATIVE_FLOAT; }
 template <> hid_t nativeType<int>() { return H5T_NATIVE_INT; }
 template <> hid_t nativeType<long>() { return H5T_NATIVE_LONG; }
 template <> hid_t nativeType<std::uint8_t>() { return H5T_NATIVE_UINT8; }
-template <> hid_t nativeType<std::int8_t>() { return H5T_NATIVE_INT8; }
 
 // A dataset of rows x cols (cols = 1: 1-D) with a `unit` attribute (and an optional description).
 template <class T>
