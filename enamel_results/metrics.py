@@ -198,7 +198,7 @@ def paired_difference(each: list[float], tol: float) -> PairedDifference:
     x = np.asarray(each, dtype=float)
     d, se = float(x.mean()), float(x.std(ddof=1) / math.sqrt(x.size))
     return PairedDifference(tuple(float(v) for v in x), d, se, float(x.min()), float(x.max()),
-                            bool(abs(d) <= tol and abs(d) <= 2 * se))
+                            bool(abs(d) + 2 * se <= tol))
 
 
 def paired_phase_comparison(a: list[RCurve], b: list[RCurve], tol: float, lo: float = RANGE_OVER_D[0],
@@ -208,9 +208,13 @@ def paired_phase_comparison(a: list[RCurve], b: list[RCurve], tol: float, lo: fl
     averaged over crack advance, and of R_init (the first point), both relative to A's. For each of the two
     quantities, with d the mean of the N pairs' differences and SE = std(ddof=1) / sqrt(N):
 
-        |d| <= tol  and  |d| <= 2 SE      (within the tolerance, and not a significant difference)
+        |d| + 2 SE <= tol      (the difference, with twice its standard error, within the tolerance)
 
-    B is the same R-curve as A when both quantities pass and every pair's common range is at least
+    so a difference is shown to be within tol only where the phases pin it down: a scatter of the pairs too large
+    for that leaves B "not shown the same" however small d is, and a precisely measured small d (R_init +0.02 %
+    +- 0.00 %) passes. (Reading "within twice its standard error" as |d| <= 2 SE instead, no significant
+    difference, would call every precisely measured difference, however small, not the same.) B is the same
+    R-curve as A when both quantities pass and every pair's common range is at least
     MIN_RANGE_OVER_D. ValueError for lists of unequal length or fewer than 2 pairs."""
     if len(a) != len(b):
         raise ValueError(f"paired phases need as many curves under each setting ({len(a)} and {len(b)})")

@@ -184,8 +184,8 @@ def verdict_line(p: metrics.PairedComparison | None, extra: list[str], pairs: in
         return f"verdict: none for {b}: {pairs} phase(s) completed under both settings, at least 2 needed"
     why = [f"{label} {q.mean:+.2%} beyond {p.tol * 100:g}%" for label, q in (("mean R", p.level), ("R_init", p.init))
            if abs(q.mean) > p.tol]
-    why += [f"{label} {q.mean:+.2%} beyond 2 SE = {2 * q.se:.2%}" for label, q in
-            (("mean R", p.level), ("R_init", p.init)) if abs(q.mean) > 2 * q.se]
+    why += [f"{label} {q.mean:+.2%} with 2 SE = {2 * q.se:.2%} reaches past {p.tol * 100:g}%" for label, q in
+            (("mean R", p.level), ("R_init", p.init)) if abs(q.mean) <= p.tol < abs(q.mean) + 2 * q.se]
     why += [] if p.comparable else [f"not comparable (a common range under {metrics.MIN_RANGE_OVER_D:g} d)"]
     head = "the same R-curve" if p.same else "NOT the same R-curve"
     return (f"verdict: {b} is {head} as the plain setting at {p.tol * 100:g}%, paired over {pairs} phases (mean R "
@@ -201,11 +201,11 @@ def compare_rows(p: metrics.PairedComparison, ks: list[int], n: int) -> list[str
         lines.append(f"| {k}/{n} | {c.mean_a:.3f} | {c.mean_b:.3f} | {pct(c.mean_rel)} | "
                      f"{p.inits_a[j]:.3f} | {p.inits_b[j]:.3f} | {pct(c.init_rel)} | "
                      f"({p.lo:g}, {c.hi:.2f}] | {'same' if c.same else 'not the same'} |")
-    lines += ["", "| quantity | mean d | SE | band (min to max) | within tol | not significant (abs(d) <= 2 SE) |",
+    lines += ["", "| quantity | mean d | SE | band (min to max) | abs(d) within tol | abs(d) + 2 SE within tol |",
               "|---|---|---|---|---|---|"]
     for label, q in (("mean R", p.level), ("R_init", p.init)):
         lines.append(f"| {label} | {pct(q.mean)} | {q.se:.2%} | {pct(q.low)} to {pct(q.high)} | "
-                     f"{abs(q.mean) <= p.tol} | {abs(q.mean) <= 2 * q.se} |")
+                     f"{abs(q.mean) <= p.tol} | {abs(q.mean) + 2 * q.se <= p.tol} |")
     lines.append(f"\nPhase-averaged mean R: A {p.mean_a:.3f}, B {p.mean_b:.3f}.")
     return lines
 
@@ -225,9 +225,9 @@ def compare_report(root_a: pathlib.Path, root_b: pathlib.Path, case: pathlib.Pat
              f"`{PHASE_KEY} = k/{n}` under both.",
              "Rule (enamel_results.metrics.paired_phase_comparison): per phase, the relative difference (B - A) / A "
              "of R averaged over crack advance over the pair's common range of (0, 30] d and of R_init; for each, "
-             f"the mean d over the pairs within the tolerance {tol * 100:g}% and within twice its standard error "
-             f"(sample std over sqrt(N)); every common range at least {metrics.MIN_RANGE_OVER_D:g} d; at least 2 "
-             "pairs."]
+             f"the mean d over the pairs, with twice its standard error (sample std over sqrt(N)), within the "
+             f"tolerance {tol * 100:g}%: abs(d) + 2 SE <= {tol * 100:g}%; every common range at least "
+             f"{metrics.MIN_RANGE_OVER_D:g} d; at least 2 pairs."]
     if p is not None:
         lines += compare_rows(p, ks, n)
     missing = [k for k in range(n) if k not in ks]
