@@ -86,3 +86,22 @@ TEST(StepScaleOfBlock, TimeStepIsTheFullModels) {
     EXPECT_DOUBLE_EQ(block.c_d, full.materials.c_d) << integrator;
   }
 }
+
+TEST(StepPlan, TheRunsPlanEndsAtTheEstimatesStepsAndTheCrackStartsBefore) {
+  // The run's plan from its first state (step 0 at the start displacement) ends where estimateRunTime's steps do.
+  for (const char* preset : {"ci", "converged"}) {
+    const CaseParams p = caseAt(preset);
+    const TimeEstimate t = estimateRunTime(p, kScale);
+    Loading loading;
+    loading.vApp = p.rate_factor * p.v_app_over_cd * kScale.c_d;
+    loading.rampTime = p.ramp_transits * p.h_s_over_d / kScale.c_d;
+    const StepPlan plan = planSteps(p, loading, kScale.dt, 0, loading.timeOfDisplacement(t.uStart));
+    EXPECT_NEAR(plan.endStep, t.steps, 1.0) << preset;
+    EXPECT_GT(plan.initiationStep, 0) << preset;
+    EXPECT_LT(plan.initiationStep, 0.9 * plan.endStep) << preset;
+    // step numbers of the run: the same plan from a later state
+    const StepPlan later = planSteps(p, loading, kScale.dt, 1000, loading.timeOfDisplacement(t.uStart) + 1000 * kScale.dt);
+    EXPECT_NEAR(later.endStep, plan.endStep, 1e-6 * plan.endStep) << preset;
+    EXPECT_NEAR(later.initiationStep, plan.initiationStep, 1e-6 * plan.endStep) << preset;
+  }
+}

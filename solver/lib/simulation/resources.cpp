@@ -88,6 +88,11 @@ double stopDisplacement(const CaseParams& p) {
   return std::min(p.stop_u_over_d, atDefaultDelta0 * p.delta0_over_d / kDefaultDelta0);
 }
 
+// Applied displacement where the crack starts to move, d: U_i (delta0 / 0.1 d), at most the stop's.
+double initiationDisplacement(const CaseParams& p) {
+  return std::min(stopDisplacement(p), kUAtInitiation * p.delta0_over_d / kDefaultDelta0);
+}
+
 // Applied displacement at the start, d: static_start x U_c, U_c = k_c (delta0 / 0.1 d) sqrt(h_s / d) (0 from rest).
 double startDisplacement(const CaseParams& p) {
   return p.static_start * kUcPerSqrtHeight * p.delta0_over_d / kDefaultDelta0 * std::sqrt(p.h_s_over_d);
@@ -121,6 +126,11 @@ TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s) {
   t.setupSeconds = setupSeconds(p, e);
   t.seconds = t.setupSeconds + t.steps * t.secondsPerStep;
   return t;
+}
+
+StepPlan planSteps(const CaseParams& p, const Loading& loading, double dt, double step, double tau) {
+  auto stepOf = [&](double U) { return step + (loading.timeOfDisplacement(U) - tau) / dt; };
+  return StepPlan{stepOf(initiationDisplacement(p)), stepOf(stopDisplacement(p))};
 }
 
 StepScale stepScaleOfBlock(const CaseParams& p) {

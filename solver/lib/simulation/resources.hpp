@@ -6,6 +6,7 @@
 #include <string>
 
 #include "case/case_params.hpp"
+#include "data/state.hpp"
 
 namespace enamel {
 
@@ -47,6 +48,17 @@ struct TimeEstimate {
 /// x v_app_over_cd x c_d after the ramp; U_end is within about 0.6x-1.6x of the committed runs' (resources.cpp),
 /// and an adaptive rate (rate_adapt_max > 1) is not counted (the estimate is then an upper bound).
 TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s);
+
+/// The steps at which a run is expected to reach the crack's start and its stop: estimateRunTime's displacements
+/// (the crack starts at U_i (delta0 / 0.1 d), the run stops at U_end) on the run's own loading and time step.
+/// Step numbers of the run (absolute, so a restart keeps them), from a state at `step` with loading clock `tau`;
+/// with an adaptive rate (rate_adapt_max > 1) the loading runs ahead of the steps, so they are upper bounds.
+/// The progress line's estimate of the time left rests on them (runner.hpp, estimateTimeLeft).
+struct StepPlan {
+  double initiationStep = NAN;  // the crack starts to move (NaN: no plan)
+  double endStep = NAN;         // the run stops
+};
+StepPlan planSteps(const CaseParams& p, const Loading& loading, double dt, double step, double tau);
 
 /// c_d and the integrator's dt of the case, measured without building its model: c_d by
 /// measureTransverseModulus (which uses at most 24 x 12 d of the case), dt from the integrator built on a block
