@@ -44,13 +44,36 @@ std::string formatDuration(double seconds) {
 }
 }  // namespace
 
-TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop) {
-  // Seconds to `target` at the rate the quantity went from `from` to `at` since the wall time `since`; NaN when
-  // the criterion is absent or the quantity has not progressed.
-  auto aim = [&](double since, double from, double at, double target) {
-    if (target <= 0 || !(at > from) || !(now.wall > since)) return double(NAN);
-    return std::max(0.0, (now.wall - since) * (target - at) / (at - from));
-  };
+namespace {
+// Seconds to `target` at the rate the quantity went from `from` to `at` since the wall time `since`; NaN when
+// the criterion is absent or the quantity has not progressed.
+double extrapolate(const ProgressSample& now, double since, double from, double at, double target) {
+  if (target <= 0 || !(at > from) || !(now.wall > since)) return NAN;
+  return std::max(0.0, (now.wall - since) * (target - at) / (at - from));
+}
+
+// The plan's steps left (estimateTimeLeft); NaN without a plan.
+double plannedStepsLeft(const StepPlan& plan, const ProgressSample& now, const StopTargets& stop) {
+  if (std::isnan(plan.initiationStep) || std::isnan(plan.endStep)) return NAN;
+  const double crackSteps = std::max(0.0, plan.endStep - plan.initiationStep);
+  if (!(now.crackAdvance > 0)) return crackSteps + std::max(0.0, plan.initiationStep - now.step);
+  const double done = stop.crackAdvance > 0 ? std::min(1.0, now.crackAdvance / stop.crackAdvance) : 1.0;
+  return crackSteps * (1 - done);
+}
+
+// Whether the crack, having moved in this piece, stands still (estimateTimeLeft).
+bool crackPaused(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop) {
+  const ProgressSample& c = marks.crackStart;
+  const double moved = now.crackAdvance - c.crackAdvance;
+  const double silence = now.wall - marks.lastAdvance.wall;
+  if (!(moved > 0) || !(silence >= kPauseMinSeconds) || !(now.wall > c.wall)) return false;
+  const double rest = stop.crackAdvance > 0 ? stop.crackAdvance - now.crackAdvance : INFINITY;
+  return silence * moved / (now.wall - c.wall) > std::min({kPauseAdvance, rest, 0.5 * moved});
+}
+}  // namespace
+
+TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop,
+                          const StepPlan& plan) {
   TimeLeft best;
   auto consider = [&](double seconds, TimeLeft::Basis basis) {
     if (std::isnan(seconds) || (!std::isnan(best.seconds) && !(seconds < best.seconds))) return;
@@ -58,24 +81,35 @@ TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now,
     best.basis = basis;
   };
   const ProgressSample& p = marks.piece;
-  consider(aim(p.wall, p.step, now.step, stop.steps), TimeLeft::Basis::steps);
-  consider(aim(p.wall, p.displacement, now.displacement, stop.displacement), TimeLeft::Basis::displacement);
   const ProgressSample& c = marks.crackStart;
-  const double crack = aim(c.wall, c.crackAdvance, now.crackAdvance, stop.crackAdvance);
-  if (!std::isnan(crack)) {
-    best.stalled = now.wall - marks.lastAdvance.wall > crack;
-    if (!best.stalled) consider(crack, TimeLeft::Basis::crack);
+  const double stepsPerSecond = now.wall > p.wall && now.step > p.step ? (now.step - p.step) / (now.wall - p.wall) : NAN;
+  const double planned = plannedStepsLeft(plan, now, stop) / stepsPerSecond;  // NaN without a plan or a rate
+  const double crack = extrapolate(now, c.wall, c.crackAdvance, now.crackAdvance, stop.crackAdvance);
+  double expected = planned;
+  if (!std::isnan(crack)) {  // blended toward the crack's rate with the share of the advance made
+    const double left = stop.crackAdvance - c.crackAdvance;  // > 0 where the crack has a rate
+    const double weight = std::clamp((now.crackAdvance - c.crackAdvance) / left, 0.0, 1.0);
+    expected = std::isnan(planned) ? crack : (1 - weight) * planned + weight * crack;
   }
+  best.paused = crackPaused(marks, now, stop);
+  best.crackAdvance = now.crackAdvance;
+  if (best.paused) expected = std::fmax(std::fmax(expected, planned), now.wall - marks.lastAdvance.wall);
+  consider(expected, std::isnan(crack) ? TimeLeft::Basis::estimate : TimeLeft::Basis::crack);
+  consider(extrapolate(now, p.wall, p.step, now.step, stop.steps), TimeLeft::Basis::steps);
+  consider(extrapolate(now, p.wall, p.displacement, now.displacement, stop.displacement), TimeLeft::Basis::displacement);
   return best;
 }
 
 std::string formatTimeLeft(const TimeLeft& t) {
   using B = TimeLeft::Basis;
-  const std::string prefix = t.stalled ? "crack stalled, " : "";
-  if (t.basis == B::none || std::isnan(t.seconds)) return t.stalled ? "crack stalled" : "?";
+  const std::string paused = t.paused ? fmt("crack paused at Delta_a %.2f d", t.crackAdvance) : "";
+  if (t.basis == B::none || std::isnan(t.seconds)) return t.paused ? paused : "?";
   const std::string d = formatDuration(t.seconds);
-  if (t.basis == B::crack) return prefix + d;
-  return prefix + "<= " + d + (t.basis == B::displacement ? " (U limit)" : " (max_steps)");
+  const std::string prefix = t.paused ? paused + ", " : "";
+  if (t.basis == B::displacement || t.basis == B::steps)
+    return prefix + "<= " + d + (t.basis == B::displacement ? " (U limit)" : " (max_steps)");
+  if (t.paused) return prefix + "estimate " + d;
+  return t.basis == B::estimate ? d + " (estimate)" : d;
 }
 
 double kineticOverStrain(const Measurement& r) {
@@ -244,8 +278,11 @@ class RunLoop {
     }
     for (const Measurement& r : rec_.history) watchLoad(r);  // from rest: one row; a restart: every row read back
     save();
-    // Progress rates are measured over this piece of the run, and the crack's from where it started.
+    // Progress rates are measured over this piece of the run, and the crack's from where it started; the run's
+    // own estimate of its steps from where it stands.
     marks_.piece = marks_.crackStart = marks_.lastAdvance = sample();
+    plan_ = planSteps(p_, sim_.materials.loading, sim_.integrator->timeStep(), double(sim_.state.step),
+                      sim_.state.loadingTime);
     for (const Measurement& r : rec_.history)  // the restart's rows: their largest ratio (not in the checkpoint)
       rec_.maxQuasiStaticRatio = std::max(rec_.maxQuasiStaticRatio, quasiStaticRatio(r));
   }
@@ -429,7 +466,7 @@ class RunLoop {
     lastProgress_ = w;
     const State& s = sim_.state;
     const ProgressSample now = sample();
-    const std::string eta = formatTimeLeft(estimateTimeLeft(marks_, now, stopTargets_));
+    const std::string eta = formatTimeLeft(estimateTimeLeft(marks_, now, stopTargets_, plan_));
     const ProgressSample& piece = marks_.piece;
     const double rate = now.wall > piece.wall ? (now.step - piece.step) / (now.wall - piece.wall) : 0;
     std::fprintf(stderr, "%sstep %ld  t %.4g  U/d %.4g  da/d %.2f  R/Gamma %.3f  broken %d  rate x%.3g  %.1f steps/s  ETA %s%s",
@@ -536,6 +573,7 @@ class RunLoop {
   double lastWrite_ = 0, lastProgress_ = 0, lastCheckpoint_ = 0, lastDa_ = 0;
   std::size_t nextFrame_ = 0;
   ProgressMarks marks_;  // where the progress line's rates are measured from
+  StepPlan plan_;        // the run's own estimate of its steps (planSteps)
   LoadDropWatch loadWatch_;  // the separated-specimen stop
 };
 

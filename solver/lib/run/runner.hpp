@@ -7,6 +7,7 @@
 
 #include "io/checkpoint.hpp"
 #include "io/output.hpp"
+#include "simulation/resources.hpp"
 #include "simulation/simulation.hpp"
 
 namespace enamel {
@@ -59,22 +60,39 @@ struct ProgressMarks {
 
 /// The estimate of the time left and what it rests on.
 struct TimeLeft {
-  enum class Basis { none, steps, crack, displacement };
-  double seconds = NAN;       // NaN: no criterion has progressed
-  Basis basis = Basis::none;  // the criterion expected first
-  bool stalled = false;       // the crack has stood still for longer than its own rate gave for the rest
+  enum class Basis { none, steps, displacement, estimate, crack };
+  double seconds = NAN;       // NaN: nothing to estimate from yet
+  Basis basis = Basis::none;  // what gives it: a stop criterion that comes first, the run's estimate or the crack
+  bool paused = false;        // the crack has moved and stands still for a while
+  double crackAdvance = 0;    // Delta_a, d (said when paused)
 };
 
-/// Seconds left to the nearest stop criterion, each extrapolated at the rate it progressed: the steps and the
-/// applied displacement since the piece started, the crack advance since the crack started (the time to
-/// initiation says nothing about the crack's speed), once it has moved in this piece. Before the crack moves the
-/// loading gives the estimate (the displacement limit, or max_steps): an upper bound, as the crack usually stops
-/// the run sooner. A crack whose silence since its last advance exceeds what its average rate gave for the rest
-/// is `stalled`, and the loading gives the estimate again. A pure function of the samples.
-TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop);
+/// A crack stands still for this long at least before it counts as paused (s of wall time).
+inline constexpr double kPauseMinSeconds = 10;
+/// ... and for longer than its average rate gives for this much advance (d), for the rest of it, or for half of
+/// the advance it made in this piece (that is: longer than it took to make it).
+inline constexpr double kPauseAdvance = 1;
 
-/// The progress line's ETA: "12 min" (the crack's), "<= 2 h 05 min (U limit)" or "<= 40 s (max_steps)" (the
-/// loading's: an upper bound), "crack stalled, <= ..." and "?" (no estimate yet).
+/// Seconds left, from the run's own estimate (`plan`: the steps at which the crack starts and the run stops,
+/// planSteps) and the rates measured in this piece of the run:
+/// - the expected time: before the crack moves, the steps left to the plan's end at this piece's steps per second
+///   (the crack's part of the plan in full once the run is past the plan's initiation, the crack being late);
+///   once the crack moves, that part's share of the crack advance left (1 - Delta_a / stop), blended toward the
+///   crack's own rate (the advance since it started in this piece, over the wall time since then) with the weight
+///   of the advance made of what was left, so at the end the crack's rate alone;
+/// - a paused crack (standing still for kPauseMinSeconds and longer than its average rate gives for
+///   kPauseAdvance, the rest, or half its advance) is said, and expected to take at least the plan's share of
+///   what is left and at least as long again as it has stood still;
+/// - the stop criteria of the loading (stop_u_over_d, max_steps, extrapolated at their rates since the piece
+///   started) replace the expected time when they come sooner.
+/// Without a plan (NaN steps), the loading's limits alone until the crack moves: an upper bound. A pure function.
+TimeLeft estimateTimeLeft(const ProgressMarks& marks, const ProgressSample& now, const StopTargets& stop,
+                          const StepPlan& plan = {});
+
+/// The progress line's ETA: "25 min (estimate)" (the run's estimate, the crack not yet moving), "12 min" (the
+/// estimate corrected by the crack's rate), "<= 2 h 05 min (U limit)" or "<= 40 s (max_steps)" (a loading limit
+/// comes first), each after "crack paused at Delta_a 3.20 d, estimate " (or ", ") while the crack is paused, and
+/// "?" (no estimate yet).
 std::string formatTimeLeft(const TimeLeft& t);
 
 /// kinetic / strain energy of a history row (0 without strain energy).
