@@ -9,6 +9,8 @@
     results        load one result.h5 (Result, Geometry, Frame), interface tags, EXIT_MISSING
     records        a run's record (records/<preset>/<run>.json): write one from a result.h5, load one as a Result
     metrics        R-curve comparison and the pooled R_m of Fig. 9
+    mechanism      measures of the mechanism: the rise length of an R-curve, and of one frame the inelastic
+                   zone, the kinks at the tip, the crack's offset from its plane, the kinks' period, far rod breaks
     cli            the figure scripts' shared command line and loading of a figure's runs
 
 figures/, bench/, pipeline/ and tests/ import it as `from enamel_results import results`; they find it because
