@@ -39,6 +39,21 @@ TEST(Integrators, RegistryHasOneRowPerIntegratorChoiceInOrder) {
   EXPECT_EQ(smallCase("lumped").integrator, IntegratorScheme::lumped);
 }
 
+TEST(Integrators, EachRowEstimatesItsSchemesCostsGrowingWithTheModel) {
+  // The estimates made before anything is built (resources.hpp) read a scheme's costs from its row alone.
+  const SchemeSizes small{1000, 6000, 20}, large{8000, 48000, 80};
+  for (const IntegratorEntry& e : integratorRegistry()) {
+    ASSERT_NE(e.estimateCosts, nullptr) << nameOf(e.scheme);
+    const CaseParams p = smallCase(nameOf(e.scheme));
+    const SchemeCosts a = e.estimateCosts(p, small), b = e.estimateCosts(p, large);
+    EXPECT_GT(a.memoryBytes, 0) << nameOf(e.scheme);
+    EXPECT_GT(a.secondsPerStep, 0) << nameOf(e.scheme);
+    EXPECT_GE(b.memoryBytes, 8 * a.memoryBytes) << nameOf(e.scheme);  // 8x the nodes, no less per node
+    EXPECT_GE(b.secondsPerStep, 8 * a.secondsPerStep) << nameOf(e.scheme);
+    EXPECT_EQ(&integratorEntry(e.scheme), &e);
+  }
+}
+
 TEST(Integrators, EachRegisteredSchemeBuildsItselfAndOneWithoutARowIsRefused) {
   for (const IntegratorEntry& e : integratorRegistry()) {
     Simulation sim(smallCase(nameOf(e.scheme)));

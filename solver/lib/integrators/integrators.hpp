@@ -73,15 +73,35 @@ class Integrator {
 /// A scheme's factory: the scheme set up for these operators.
 using IntegratorFactory = std::unique_ptr<Integrator> (*)(const CaseParams& p, const Model& m, const Materials& mat,
                                                           const Operators& ops);
-/// A row of the table of schemes: the `integrator` key's value that chooses it (its name: nameOf(scheme)), and its
-/// factory.
+/// The counts of a case's model that a scheme's cost estimate reads (estimateResources, simulation/resources.hpp:
+/// from the case keys alone, before anything is built).
+struct SchemeSizes {
+  double nodes = 0;
+  double dof = 0;
+  double nodesPerSlice = 0;  // the bandwidth of a factor of M or K
+};
+/// A scheme's share of a run's costs: the peak resident memory of the model's data and the scheme's own (the
+/// executable and the static start's factor are the estimate's), and one core's seconds per step.
+struct SchemeCosts {
+  double memoryBytes = 0;
+  double secondsPerStep = 0;
+};
+/// A scheme's cost estimate: a pure function of the case and its sizes, measured on runs of the scheme (its file
+/// gives the measurements).
+using IntegratorCostEstimate = SchemeCosts (*)(const CaseParams& p, const SchemeSizes& sizes);
+/// A row of the table of schemes: the `integrator` key's value that chooses it (its name: nameOf(scheme)), its
+/// factory and its cost estimate (made before the scheme is built: enamel-dem info --estimate, the memory check).
 struct IntegratorEntry {
   IntegratorScheme scheme;
   IntegratorFactory make;
+  IntegratorCostEstimate estimateCosts;
 };
 /// Every scheme of this build, one row per enumerator of IntegratorScheme in its order (integrators/registry.cpp;
 /// tests/cpp/test_integrators.cpp checks that they agree).
 const std::vector<IntegratorEntry>& integratorRegistry();
+
+/// The row of integratorRegistry() of this scheme; IntegratorError when the build has none.
+const IntegratorEntry& integratorEntry(IntegratorScheme scheme);
 
 /// The integrator named by p.integrator (its row of integratorRegistry()), set up for these operators. Throws
 /// IntegratorError when no row has that name, when dt is above the stable limit; SolverError when a factorisation

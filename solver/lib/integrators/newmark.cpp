@@ -202,4 +202,19 @@ std::unique_ptr<Integrator> makePaperIntegrator(const CaseParams& p, const Model
   return std::make_unique<PaperIntegrator>(p, mat, ops);
 }
 
+// Peak resident memory (VmHWM, /meta/peak_memory_mb) measured on theta30, 20 steps, 1 thread: 40 x 20 d: 4640
+// nodes 65 MB; 40 x 40 d: 9284 nodes 120 MB -> 6.4 kB per node + ~52 B per node per node of a slice (the
+// Cholesky factor's fill grows with the bandwidth); rounded up by ~10%.
+// Seconds per step (consistent mass, CHOLMOD solve per step), per DOF: a + b x nodes of a slice (the factor's
+// bandwidth); one core, CPU (user) seconds, measured 9.7e-8 s at 16 x 8 d (13.9 nodes a slice) and 1.22e-7 at
+// 40 x 20 d (34.6), 3000 and 600 steps less a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench`'s cost
+// growth. The constants give 1.11x, 1.22x and 1.14x of these; at the paper preset's 346 nodes a slice, an
+// extrapolation.
+SchemeCosts paperCosts(const CaseParams&, const SchemeSizes& n) {
+  constexpr double kBytesPerNode = 6500, kFillBytesPerNodeSliceNode = 60;
+  constexpr double kSecondsPerDof = 8e-8, kSecondsPerDofSliceNode = 2e-9;
+  return SchemeCosts{n.nodes * (kBytesPerNode + kFillBytesPerNodeSliceNode * n.nodesPerSlice),
+                     n.dof * (kSecondsPerDof + kSecondsPerDofSliceNode * n.nodesPerSlice)};
+}
+
 }  // namespace enamel

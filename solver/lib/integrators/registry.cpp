@@ -11,21 +11,25 @@ namespace enamel {
 
 const std::vector<IntegratorEntry>& integratorRegistry() {
   static const std::vector<IntegratorEntry> table = {
-      {IntegratorScheme::paper, makePaperIntegrator},
-      {IntegratorScheme::lumped, makeLumpedIntegrator},
+      {IntegratorScheme::paper, makePaperIntegrator, paperCosts},
+      {IntegratorScheme::lumped, makeLumpedIntegrator, lumpedCosts},
   };
   return table;
 }
 
-std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, const Materials& mat,
-                                           const Operators& ops) {
+const IntegratorEntry& integratorEntry(IntegratorScheme scheme) {
   std::string available;
   for (const IntegratorEntry& e : integratorRegistry()) {
-    if (p.integrator == e.scheme) return e.make(p, m, mat, ops);
+    if (scheme == e.scheme) return e;
     available += (available.empty() ? "" : ", ") + nameOf(e.scheme);
   }
-  throw IntegratorError("integrator '" + nameOf(p.integrator) + "' is not available in this build (available: " +
+  throw IntegratorError("integrator '" + nameOf(scheme) + "' is not available in this build (available: " +
                         available + ")");
+}
+
+std::unique_ptr<Integrator> makeIntegrator(const CaseParams& p, const Model& m, const Materials& mat,
+                                           const Operators& ops) {
+  return integratorEntry(p.integrator).make(p, m, mat, ops);
 }
 
 }  // namespace enamel

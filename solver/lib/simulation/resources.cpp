@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "integrators/integrators.hpp"
 #include "simulation/setup.hpp"
 #include "simulation/simulation.hpp"
 
@@ -12,20 +13,18 @@ namespace enamel {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-// Peak resident memory (VmHWM, /meta/peak_memory_mb) measured on theta30, 20 steps, 1 thread:
-//   lumped  16 x 8 d: 748 nodes 32 MB;  40 x 20 d: 4640 nodes 59 MB;  80 x 80 d: 37136 nodes 270 MB;
-//           200 x 200 d (paper preset): 231k nodes 1630 MB            -> ~6.5-7 kB per node
-//   paper   40 x 20 d: 4640 nodes 65 MB;  40 x 40 d: 9284 nodes 120 MB -> 6.4 kB per node + ~52 B per node
-//           per node of a slice (the Cholesky factor's fill grows with the bandwidth)
-//   static_start > 0 adds the elastic stiffness's Cholesky factor (rods and interfaces; OpenBLAS): lumped
-//           40 x 20 d 59 -> 130 MB, 200 x 200 d 1630 -> 7520 MB: ~14.2 kB per node + ~33 B per node of a slice
-// The constants round these up by ~10%.
-constexpr double kLumpedBytesPerNode = 7000;
-constexpr double kPaperBytesPerNode = 6500;
-constexpr double kPaperFillBytesPerNodeSliceNode = 60;
+// Peak resident memory beyond the scheme's own (its registry row's estimateCosts, integrators.hpp), VmHWM
+// (/meta/peak_memory_mb) measured on theta30, 20 steps, 1 thread: static_start > 0 adds the elastic stiffness's
+// Cholesky factor (rods and interfaces; OpenBLAS): lumped 40 x 20 d 59 -> 130 MB, 200 x 200 d 1630 -> 7520 MB:
+// ~14.2 kB per node + ~33 B per node of a slice. The constants round these up by ~10%.
 constexpr double kStaticBytesPerNode = 15600;
 constexpr double kStaticFillBytesPerNodeSliceNode = 36;
 constexpr double kBaseBytes = 30e6;  // the executable, libraries and the transverse-modulus block
+
+// The scheme's own costs (its row of the integrators' registry), from the counts.
+SchemeCosts schemeCosts(const CaseParams& p, const ResourceEstimate& e) {
+  return integratorEntry(p.integrator).estimateCosts(p, SchemeSizes{e.nodes, e.dof, e.nodes / e.slices});
+}
 }  // namespace
 
 ResourceEstimate estimateResources(const CaseParams& p) {
@@ -36,9 +35,7 @@ ResourceEstimate estimateResources(const CaseParams& p) {
   e.nodes = e.slices * perSlice;
   e.dof = 6 * e.nodes;
   e.interfaces = 3 * e.nodes;
-  e.memoryBytes = kBaseBytes + (p.integrator == IntegratorScheme::paper
-                                    ? e.nodes * (kPaperBytesPerNode + kPaperFillBytesPerNodeSliceNode * perSlice)
-                                    : e.nodes * kLumpedBytesPerNode);
+  e.memoryBytes = kBaseBytes + schemeCosts(p, e).memoryBytes;
   if (p.static_start > 0) e.memoryBytes += e.nodes * (kStaticBytesPerNode + kStaticFillBytesPerNodeSliceNode * perSlice);
   return e;
 }
@@ -65,16 +62,7 @@ constexpr double kUPerCrackAdvance = 0.5;  // d per d of crack advance
 // start): k_c sqrt(h_s / d) with
 // k_c = 0.096-0.121; a low U_c skips less of the run, so k_c is on the low side of the larger sizes.
 constexpr double kUcPerSqrtHeight = 0.11;
-// Seconds per step. `lumped`: DOF-updates per second per core. Whole ci runs 52-93 M (the five cases above),
-// the whole reduced run 69 M, 2000 elastic steps at 80 x 80 d 109 M (user time less that of a 1-step run); on
-// the same machine kind unloaded `make bench` measured 127 M at 40 x 20 d. 40 M allows for a
-// slower core, a larger specimen (fewer cache hits) and the fracture stage's interface law.
-constexpr double kLumpedDofUpdatesPerSecond = 40e6;
-// `paper` (consistent mass, CHOLMOD solve per step), per DOF: a + b x nodes of a slice (the factor's bandwidth);
-// measured 9.7e-8 s at 16 x 8 d (13.9 nodes a slice) and 1.22e-7 at 40 x 20 d (34.6), 3000 and 600 steps less
-// a 1-step run; 1.92e-7 at 80 x 40 d (69.3) by `make bench`'s cost growth. The
-// constants give 1.11x, 1.22x and 1.14x of these; at the paper preset's 346 nodes a slice, an extrapolation.
-constexpr double kPaperSecondsPerDof = 8e-8, kPaperSecondsPerDofSliceNode = 2e-9;
+// Seconds per step: the scheme's own (its registry row's estimateCosts, integrators.hpp).
 // Set-up (the model, operators, integrator, c_d's block), per DOF: 1.8e-5 s user at 80 x 80 d (a 1-step run).
 // The static start's solve, per DOF and node of a slice: 82 s on 2 cores at 200 x 200 d (3.4e-7 core-s), 91 s
 // wall at 80 x 80 d under load (2.9e-6).
@@ -98,13 +86,6 @@ double startDisplacement(const CaseParams& p) {
   return p.static_start * kUcPerSqrtHeight * p.delta0_over_d / kDefaultDelta0 * std::sqrt(p.h_s_over_d);
 }
 
-// One core's seconds per step: `lumped` a DOF-update rate; `paper` also the Cholesky solve, whose cost per DOF
-// grows with the nodes of a slice (the factor's bandwidth).
-double secondsPerStep(const CaseParams& p, const ResourceEstimate& e) {
-  if (p.integrator == IntegratorScheme::paper) return e.dof * (kPaperSecondsPerDof + kPaperSecondsPerDofSliceNode * e.nodes / e.slices);
-  return e.dof / kLumpedDofUpdatesPerSecond;
-}
-
 double setupSeconds(const CaseParams& p, const ResourceEstimate& e) {
   const double staticSolve = p.static_start > 0 ? kStaticSecondsPerDofSliceNode * e.dof * e.nodes / e.slices : 0;
   return kSetupSecondsPerDof * e.dof + staticSolve;
@@ -122,7 +103,7 @@ TimeEstimate estimateRunTime(const CaseParams& p, const StepScale& s) {
   t.duration = loading.timeOfDisplacement(t.uEnd) - loading.timeOfDisplacement(t.uStart);
   t.steps = std::ceil(t.duration / s.dt);
   if (p.max_steps > 0) t.steps = std::min(t.steps, static_cast<double>(p.max_steps));
-  t.secondsPerStep = secondsPerStep(p, e);
+  t.secondsPerStep = schemeCosts(p, e).secondsPerStep;
   t.setupSeconds = setupSeconds(p, e);
   t.seconds = t.setupSeconds + t.steps * t.secondsPerStep;
   return t;

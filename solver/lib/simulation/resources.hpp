@@ -20,9 +20,10 @@ struct ResourceEstimate {
   double memoryBytes = 0;  // peak resident memory of a run
 };
 
-/// Estimate from the case keys. Memory: bytes per node measured (VmHWM) at two sizes per integrator
-/// (resources.cpp gives the measurements); the `paper` scheme adds its Cholesky factor, whose fill grows with
-/// the nodes of a slice (the bandwidth). Within ~10% of the measured peaks, on the high side.
+/// Estimate from the case keys. Memory: the scheme's own, from its row of the integrators' registry
+/// (IntegratorEntry::estimateCosts: bytes per node measured (VmHWM) at two sizes or more, its file gives the
+/// measurements; a scheme with a factor adds its fill, which grows with the nodes of a slice), the static start's
+/// factor and the executable (resources.cpp). Within ~10% of the measured peaks, on the high side.
 ResourceEstimate estimateResources(const CaseParams& p);
 
 /// The two numbers of the case's own model that the duration of a run needs (stepScaleOfBlock).
@@ -43,7 +44,7 @@ struct TimeEstimate {
 };
 
 /// One core's wall time of a whole run (a pure function of the case keys, c_d and dt; resources.cpp gives the
-/// model and the measurements behind its constants). The run's duration is that of the loading from the start
+/// model and the measurements behind its constants, the scheme's registry row its seconds per step). The run's duration is that of the loading from the start
 /// displacement to U_end = (U_i + k_a stop_da_over_d) (delta0 / 0.1 d) (at most stop_u_over_d), at v_app = rate_factor
 /// x v_app_over_cd x c_d after the ramp; U_end is within about 0.6x-1.6x of the committed runs' (resources.cpp),
 /// and an adaptive rate (rate_adapt_max > 1) is not counted (the estimate is then an upper bound).
