@@ -8,6 +8,7 @@ and, for the size, one ci run (conftest.ci_run), all in temporary folders.
 """
 import contextlib
 import csv
+import datetime
 import hashlib
 import io
 import json
@@ -339,7 +340,7 @@ def test_update_rewrites_a_record_of_an_older_run_and_keeps_one_of_a_newer_run(t
     assert "an older run" in capsys.readouterr().out
     assert records.record_is_of(records.read_record(record), h5)
     with h5py.File(h5, "r+") as f:   # the run there is older than the record's
-        f["meta"].attrs["written_utc"] = "2000-01-01T00:00:00Z"
+        f["meta"].attrs["written_utc"] = datetime.datetime(2000, 1, 1).strftime("%Y-%m-%dT%H:%M:%SZ")
     results.seal_result_file(h5)
     before = record.read_bytes()
     assert records_cli.main(update) == 0
