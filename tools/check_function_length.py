@@ -108,21 +108,28 @@ def long_functions(path: pathlib.Path, limit: int) -> list[tuple[int, str, int]]
     return out
 
 
-def main(argv: list[str]) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def run_check(argv: list[str], doc: str, name: str, default_files, long_functions_of) -> int:
+    """The command line both length checks share: --limit N and files (default_files() when none), one line
+    `file:line: name (N lines)` per function over the limit from long_functions_of(path, limit); exit 1 if any."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--limit", type=int, default=80)
     p.add_argument("files", nargs="*", type=pathlib.Path)
     a = p.parse_args(argv)
-    files = a.files or sorted([*ROOT.glob("solver/**/*.cpp"), *ROOT.glob("solver/**/*.hpp")])
+    files = a.files or default_files()
     found = 0
     for f in files:
-        for line, name, length in long_functions(f, a.limit):
-            shown = f.relative_to(ROOT) if f.is_relative_to(ROOT) else f
-            print(f"{shown}:{line}: {name} ({length} lines)")
+        for line, function, length in long_functions_of(f, a.limit):
+            shown = f.resolve().relative_to(ROOT) if f.resolve().is_relative_to(ROOT) else f
+            print(f"{shown}:{line}: {function} ({length} lines)")
             found += 1
     if not found:
-        print(f"check_function_length: no function over {a.limit} lines in {len(files)} files")
+        print(f"{name}: no function over {a.limit} lines in {len(files)} files")
     return 1 if found else 0
+
+
+def main(argv: list[str]) -> int:
+    return run_check(argv, __doc__, "check_function_length",
+                     lambda: sorted([*ROOT.glob("solver/**/*.cpp"), *ROOT.glob("solver/**/*.hpp")]), long_functions)
 
 
 if __name__ == "__main__":

@@ -7,10 +7,14 @@ from its `def` line to its last one (decorators left out, its docstring, comment
 Standard library only: `python3 tools/check_python_function_length.py [--limit N] [files...]`."""
 from __future__ import annotations
 
-import argparse
 import ast
 import pathlib
 import sys
+
+try:  # the command line is the C++ check's: imported as tools.check_..., or run as a script from tools/
+    from tools.check_function_length import run_check
+except ImportError:
+    from check_function_length import run_check
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PRODUCT = ("pipeline", "enamel_results", "figures", "bench", "tools")
@@ -41,20 +45,7 @@ def long_functions(path: pathlib.Path, limit: int) -> list[tuple[int, str, int]]
 
 
 def main(argv: list[str]) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--limit", type=int, default=80)
-    p.add_argument("files", nargs="*", type=pathlib.Path)
-    a = p.parse_args(argv)
-    files = a.files or product_files()
-    found = 0
-    for f in files:
-        for line, name, length in long_functions(f, a.limit):
-            shown = f.resolve().relative_to(ROOT) if f.resolve().is_relative_to(ROOT) else f
-            print(f"{shown}:{line}: {name} ({length} lines)")
-            found += 1
-    if not found:
-        print(f"check_python_function_length: no function over {a.limit} lines in {len(files)} files")
-    return 1 if found else 0
+    return run_check(argv, __doc__, "check_python_function_length", product_files, long_functions)
 
 
 if __name__ == "__main__":
