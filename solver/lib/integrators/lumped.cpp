@@ -183,7 +183,6 @@ class LumpedIntegrator : public Integrator {
       throw IntegratorError(msg.str());
     }
     if (implicit_) {
-      sliceOfNode_ = m.nodeSlice;
       rodSolve_ = factoriseRodDamping(ops.K, mass_, ops.prescribedDofs, m.nodeRod, 1.0 + 0.5 * dampA_ * dt_,
                                       dt_ * bEff_);
     }
@@ -216,7 +215,7 @@ class LumpedIntegrator : public Integrator {
     laps.lap(StepPhase::InterfaceSchedule);
     s.failedInterfaces = computeForcesAndAdvanceVelocities(m, mat, ops, s);
     laps.lap(StepPhase::SlicePass);
-    if (implicit_) solveRodDampingOfStep(ops, s);
+    if (implicit_) solveRodDampingOfStep(m, ops, s);
     laps.lap(StepPhase::RodDamping);
     computeReactions(ops, s);
     addWorkOfGrips(s, computeGripPower(s.reaction, vGrip_), dt_, s.step > 0);
@@ -347,7 +346,7 @@ class LumpedIntegrator : public Integrator {
   // then slice by slice q_{n+1} = q_n + dt v_{n+1/2} and the slice's sums: max |dt v|, max |q|, v.Mv and v.Kv (on
   // a free row from the solve's identity dt b (K v)_f = s m_f (v*_f - v_f); on a grip's v* = v, and its v.Kv from
   // its row of K); the grips' b K v into their residuals.
-  void solveRodDampingOfStep(const Operators& ops, State& s) {
+  void solveRodDampingOfStep(const Model& m, const Operators& ops, State& s) {
     std::swap(s.vHalf, vStar_);  // v* (the pass's) kept; s.vHalf becomes the solve's output
     s.vHalf.resize(vStar_.size());
     solveRodDamping(rodSolve_, vStar_, s.vHalf);
@@ -372,7 +371,7 @@ class LumpedIntegrator : public Integrator {
     multiplyGripRows(rodSolve_, s.vHalf, KvGrip_);
     for (std::size_t i = 0; i < ops.prescribedDofs.size(); ++i) {
       rows_.gripResidual[i] += bEff_ * KvGrip_[i];
-      sliceSums_[sliceOfNode_[ops.prescribedDofs[i] / 6]].workK[1] += s.vHalf[ops.prescribedDofs[i]] * KvGrip_[i];
+      sliceSums_[m.nodeSlice[ops.prescribedDofs[i] / 6]].workK[1] += s.vHalf[ops.prescribedDofs[i]] * KvGrip_[i];
     }
   }
 
@@ -427,7 +426,6 @@ class LumpedIntegrator : public Integrator {
   bool interfaceStep_ = false;       // step_rule = interfaces: omega_max of M^-1 K_I, physical rotary inertia
   RodDampingSolve rodSolve_;         // its factors (rod_damping.hpp)
   VecX vStar_, KvGrip_;              // the pass's v*, and the grips' rows of K v_{n+1/2}
-  std::vector<int> sliceOfNode_;     // per node: its slice
   double largestShape_ = 0;          // max |shape| of the prescribed DOFs
   double moveBound_ = INFINITY;      // lastStepMoveBound (infinite: q was set otherwise, the schedules start afresh)
   double largestValue_ = INFINITY;   // a bound on max |q_n|
